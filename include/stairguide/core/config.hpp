@@ -1,0 +1,272 @@
+#pragma once
+/// \file config.hpp
+/// Every tunable of the pipeline, one struct per stage, with defaults written here.
+///
+/// Values inside are SI (metres, seconds, radians, fractions). The YAML file uses the units named
+/// in each key's suffix (`_cm`, `_deg`, `_percent`, ...); the loader converts. Each struct lists its
+/// fields once in `visit()`: the loader, the YAML writer and the equality test all walk that list,
+/// so a field cannot be known to one and forgotten by another.
+///
+/// A visitor `V` provides:
+///   v.num(field, "key", Unit, min, max, "comment")  - float/double/int, range in file units
+///   v.flag(field, "key", "comment")                 - bool
+///   v.text(field, "key", {"a","b"} or {}, "comment") - string, optional list of allowed values
+///   v.section("name", "comment", sub_struct)
+
+#include <string>
+#include <vector>
+
+namespace stairguide {
+
+/// Unit of a value in the YAML file; the loader converts it to SI.
+enum class Unit { kNone, kMetre, kCentimetre, kMillimetre, kDegree, kPercent, kSecond, kMillisecond,
+                  kHertz, kPerMetre, kPixel, kCount };
+
+/// Factor from file unit to SI (cm -> m is 0.01, deg -> rad is pi/180, percent -> fraction 0.01).
+double unit_to_si(Unit u);
+/// Short unit name for comments and messages ("cm", "deg", ...); empty for kNone.
+const char* unit_name(Unit u);
+
+struct CaptureConfig {
+  std::string device_uri = "";   ///< OpenNI2 device URI; empty = first device found
+  int width = 640;               ///< px, requested depth/colour mode
+  int height = 480;              ///< px
+  int fps = 30;                  ///< Hz
+  bool depth_registration = true;  ///< register depth to colour in the device
+  bool mirroring = false;        ///< image mirroring in the device
+  float read_timeout = 2.0f;     ///< s without a frame before the camera counts as lost
+  float retry_min = 0.5f;        ///< s, first reconnect delay
+  float retry_max = 8.0f;        ///< s, longest reconnect delay (exponential back-off)
+  float max_range = 5.0f;        ///< m, depth beyond this is discarded as unreliable
+  float min_range = 0.4f;        ///< m, depth below this is discarded
+
+  template <class V> void visit(V& v) {
+    v.text(device_uri, "device_uri", {}, "OpenNI2 device URI; empty picks the first camera");
+    v.num(width, "width_px", Unit::kPixel, 80, 1920, "depth and colour width");
+    v.num(height, "height_px", Unit::kPixel, 60, 1080, "depth and colour height");
+    v.num(fps, "fps_hz", Unit::kHertz, 1, 120, "frame rate requested from the camera");
+    v.flag(depth_registration, "depth_registration", "register depth to colour in the device");
+    v.flag(mirroring, "mirroring", "mirror the images in the device (off for a body camera)");
+    v.num(read_timeout, "read_timeout_s", Unit::kSecond, 0.1, 60, "no frame for this long = camera lost");
+    v.num(retry_min, "retry_min_s", Unit::kSecond, 0.05, 60, "first reconnect delay");
+    v.num(retry_max, "retry_max_s", Unit::kSecond, 0.05, 600, "longest reconnect delay (back-off doubles up to it)");
+    v.num(min_range, "min_range_m", Unit::kMetre, 0.0, 2.0, "depth nearer than this is dropped");
+    v.num(max_range, "max_range_m", Unit::kMetre, 0.5, 20.0, "depth farther than this is dropped");
+  }
+};
+
+struct SegmentationConfig {
+  float voxel_size = 0.04f;          ///< m, voxel grid edge (paper: 3-4 cm)
+  float normal_radius = 0.05f;       ///< m, neighbourhood for PCA normals
+  float region_angle = 0.10471976f;  ///< rad, region growing normal deviation (6 deg)
+  float region_curvature = 0.5f;     ///< region growing curvature threshold
+  int region_min_points = 50;        ///< points (voxels) in a region
+  float planarity_min_inliers = 0.8f;  ///< fraction of a region's points on its RANSAC plane
+  float cluster_tolerance = 0.08f;   ///< m, Euclidean clustering distance for non-planar points
+  int cluster_min_points = 30;       ///< points in an obstacle cluster
+
+  template <class V> void visit(V& v) {
+    v.num(voxel_size, "voxel_size_cm", Unit::kCentimetre, 0.5, 20, "voxel grid edge (paper: 3-4 cm)");
+    v.num(normal_radius, "normal_radius_cm", Unit::kCentimetre, 1, 50, "radius of the PCA normal neighbourhood");
+    v.num(region_angle, "region_angle_deg", Unit::kDegree, 0.5, 45, "region growing: max normal deviation");
+    v.num(region_curvature, "region_curvature", Unit::kNone, 0.0, 10, "region growing: curvature threshold");
+    v.num(region_min_points, "region_min_points", Unit::kCount, 3, 100000, "smallest planar region");
+    v.num(planarity_min_inliers, "planarity_min_inliers_percent", Unit::kPercent, 10, 100,
+          "a region is planar when this share of it lies on its RANSAC plane");
+    v.num(cluster_tolerance, "cluster_tolerance_cm", Unit::kCentimetre, 0.5, 100, "Euclidean clustering distance");
+    v.num(cluster_min_points, "cluster_min_points", Unit::kCount, 1, 100000, "smallest obstacle cluster");
+  }
+};
+
+struct FloorConfig {
+  float tilt_min = 0.34906585f;   ///< rad, camera pitch below horizontal (20 deg)
+  float tilt_max = 1.22173048f;   ///< rad (70 deg)
+  float roll_max = 0.34906585f;   ///< rad, |roll| allowed (20 deg)
+  float height_min = 1.0f;        ///< m, camera above the floor
+  float height_max = 1.6f;        ///< m
+  float search_start = 1.0f;      ///< m, first z_C window for floor points
+  float search_step = 0.5f;       ///< m, window growth per attempt
+  float search_max = 4.0f;        ///< m, largest window
+  float inlier_distance = 0.04f;  ///< m, plane inlier distance (paper: the voxel edge)
+  float min_area = 0.25f;         ///< m^2, smallest floor patch
+  float track_max_height_jump = 0.08f;  ///< m, change of camera height accepted between frames
+  float track_max_angle_jump = 0.17453293f;  ///< rad, change of floor normal accepted between frames
+
+  template <class V> void visit(V& v) {
+    v.num(tilt_min, "tilt_min_deg", Unit::kDegree, 0, 90, "camera pitch below horizontal: lowest");
+    v.num(tilt_max, "tilt_max_deg", Unit::kDegree, 0, 90, "camera pitch below horizontal: highest");
+    v.num(roll_max, "roll_max_deg", Unit::kDegree, 0, 90, "largest camera roll");
+    v.num(height_min, "height_min_m", Unit::kMetre, 0.1, 3, "camera height above the floor: lowest");
+    v.num(height_max, "height_max_m", Unit::kMetre, 0.1, 3, "camera height above the floor: highest");
+    v.num(search_start, "search_start_m", Unit::kMetre, 0.2, 10, "first forward window searched for floor");
+    v.num(search_step, "search_step_m", Unit::kMetre, 0.05, 10, "window growth per attempt");
+    v.num(search_max, "search_max_m", Unit::kMetre, 0.2, 20, "largest forward window");
+    v.num(inlier_distance, "inlier_distance_cm", Unit::kCentimetre, 0.2, 20, "plane inlier distance (paper: voxel edge)");
+    v.num(min_area, "min_area_m2", Unit::kNone, 0.01, 100, "smallest floor patch, square metres");
+    v.num(track_max_height_jump, "track_max_height_jump_cm", Unit::kCentimetre, 0.5, 100,
+          "camera height change accepted from one frame to the next");
+    v.num(track_max_angle_jump, "track_max_angle_jump_deg", Unit::kDegree, 0.5, 90,
+          "floor normal change accepted from one frame to the next");
+  }
+};
+
+struct ManhattanConfig {
+  float vertical_tolerance = 0.17453293f;  ///< rad, a plane counts as vertical within this (10 deg)
+  float min_points_fraction = 0.05f;       ///< share of points on vertical planes for a Manhattan scene
+
+  template <class V> void visit(V& v) {
+    v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
+          "a plane is vertical within this angle");
+    v.num(min_points_fraction, "min_points_percent", Unit::kPercent, 0, 100,
+          "share of points on vertical planes needed to call the scene Manhattan");
+  }
+};
+
+struct ClassificationConfig {
+  float parallel_threshold = 0.17453293f;  ///< rad, parallel/perpendicular tolerance (10 deg)
+  float step_height_min = 0.13f;           ///< m, H_min
+  float step_height_max = 0.185f;          ///< m, H_max
+  float floor_height_tolerance = 0.04f;    ///< m, a horizontal plane this close to 0 is floor
+
+  template <class V> void visit(V& v) {
+    v.num(parallel_threshold, "parallel_threshold_deg", Unit::kDegree, 0.5, 45,
+          "tolerance for parallel and perpendicular");
+    v.num(step_height_min, "step_height_min_cm", Unit::kCentimetre, 1, 100, "H_min, lowest step riser");
+    v.num(step_height_max, "step_height_max_cm", Unit::kCentimetre, 1, 100, "H_max, highest step riser");
+    v.num(floor_height_tolerance, "floor_height_tolerance_cm", Unit::kCentimetre, 0.5, 50,
+          "a horizontal plane within this of the floor is floor");
+  }
+};
+
+struct StairDetectionConfig {
+  float same_level_tolerance = 0.03f;  ///< m, candidates within this height form one level
+  float connection_radius = 0.5f;      ///< m, neighbour search radius between regions
+  int connection_min_points = 10;      ///< points within the radius for a connection
+
+  template <class V> void visit(V& v) {
+    v.num(same_level_tolerance, "same_level_tolerance_cm", Unit::kCentimetre, 0.5, 20,
+          "candidates within this height are one level");
+    v.num(connection_radius, "connection_radius_m", Unit::kMetre, 0.05, 5, "neighbour search radius between regions");
+    v.num(connection_min_points, "connection_min_points", Unit::kCount, 1, 100000, "points within the radius to connect");
+  }
+};
+
+struct StairModellingConfig {
+  float riser_min = 0.13f;        ///< m, building code
+  float riser_max = 0.185f;       ///< m
+  float tread_min = 0.28f;        ///< m
+  float blondel_min = 0.54f;      ///< m, 2R + T lower bound
+  float blondel_max = 0.70f;      ///< m, 2R + T upper bound
+  float width_min = 0.6f;         ///< m
+  float manhattan_min_fraction = 0.1f;  ///< share of Manhattan points to use the Manhattan axes
+
+  template <class V> void visit(V& v) {
+    v.num(riser_min, "riser_min_cm", Unit::kCentimetre, 1, 100, "building code: lowest riser");
+    v.num(riser_max, "riser_max_cm", Unit::kCentimetre, 1, 100, "building code: highest riser");
+    v.num(tread_min, "tread_min_cm", Unit::kCentimetre, 1, 200, "building code: shortest tread");
+    v.num(blondel_min, "blondel_min_cm", Unit::kCentimetre, 10, 300, "building code: lowest 2R+T");
+    v.num(blondel_max, "blondel_max_cm", Unit::kCentimetre, 10, 300, "building code: highest 2R+T");
+    v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "narrowest staircase");
+    v.num(manhattan_min_fraction, "manhattan_min_percent", Unit::kPercent, 0, 100,
+          "share of Manhattan points needed to take the stair axes from the Manhattan frame");
+  }
+};
+
+struct OdometryConfig {
+  float sigma_intensity = 5.0f;     ///< intensity units (0-255), photometric residual scale
+  float sigma_inv_depth = 0.0025f;  ///< 1/m, inverse-depth residual scale
+  float student_nu = 5.0f;          ///< Student-t degrees of freedom
+  int pyramid_levels = 3;
+  int iterations = 10;              ///< per pyramid level
+  float min_valid_fraction = 0.05f; ///< share of pixels with depth needed to track
+  float max_translation = 0.3f;     ///< m per frame beyond which the estimate is a failure
+  float max_rotation = 0.35f;       ///< rad per frame beyond which the estimate is a failure
+  int threads = 1;                  ///< 1 or 2 threads over image rows
+
+  template <class V> void visit(V& v) {
+    v.num(sigma_intensity, "sigma_intensity", Unit::kNone, 0.01, 255, "photometric scale sigma_I, grey levels 0-255");
+    v.num(sigma_inv_depth, "sigma_inv_depth_per_m", Unit::kPerMetre, 1e-6, 1, "inverse-depth scale sigma_W, 1/m");
+    v.num(student_nu, "student_nu", Unit::kNone, 1, 100, "Student-t degrees of freedom (weights (nu+1)/(nu+x^2))");
+    v.num(pyramid_levels, "pyramid_levels", Unit::kCount, 1, 6, "image pyramid levels, coarse to fine");
+    v.num(iterations, "iterations", Unit::kCount, 1, 100, "Gauss-Newton iterations per level");
+    v.num(min_valid_fraction, "min_valid_percent", Unit::kPercent, 0.1, 100, "pixels with depth needed to track");
+    v.num(max_translation, "max_translation_cm", Unit::kCentimetre, 1, 500, "motion per frame beyond walking = failure");
+    v.num(max_rotation, "max_rotation_deg", Unit::kDegree, 1, 180, "rotation per frame beyond walking = failure");
+    v.num(threads, "threads", Unit::kCount, 1, 2, "threads over image rows");
+  }
+};
+
+struct RuntimeConfig {
+  std::string log_level = "info";  ///< spdlog level
+  int ring_capacity = 8;           ///< frames per ring buffer
+  float status_interval = 5.0f;    ///< s between counter logs / STATUS updates
+  bool realtime = true;            ///< replay paced by timestamps (false: as fast as possible)
+
+  template <class V> void visit(V& v) {
+    v.text(log_level, "log_level", {"trace", "debug", "info", "warn", "error", "critical", "off"}, "log level");
+    v.num(ring_capacity, "ring_capacity", Unit::kCount, 2, 1024, "frames held by each ring buffer");
+    v.num(status_interval, "status_interval_s", Unit::kSecond, 0.1, 3600, "seconds between counter reports");
+    v.flag(realtime, "realtime_replay", "pace a replay by its timestamps (false: as fast as possible)");
+  }
+};
+
+struct FeedbackConfig {
+  bool audio_enabled = true;
+  std::string audio_device = "default";   ///< ALSA PCM name
+  std::string sounds_dir = "/usr/share/stairguide/sounds";
+  float volume = 0.8f;                    ///< fraction of full scale
+  bool haptic_enabled = true;
+  std::string gpio_chip = "gpiochip0";
+  int gpio_line = 17;
+  float min_cue_interval = 1.5f;          ///< s between two cues of the same kind
+  float announce_distance = 4.0f;         ///< m, announce stairs nearer than this
+
+  template <class V> void visit(V& v) {
+    v.flag(audio_enabled, "audio_enabled", "play audio cues");
+    v.text(audio_device, "audio_device", {}, "ALSA PCM for the cues");
+    v.text(sounds_dir, "sounds_dir", {}, "folder of the WAV cues");
+    v.num(volume, "volume_percent", Unit::kPercent, 0, 100, "cue volume");
+    v.flag(haptic_enabled, "haptic_enabled", "drive the buzzer on the GPIO line");
+    v.text(gpio_chip, "gpio_chip", {}, "GPIO chip of the buzzer (name or /dev path)");
+    v.num(gpio_line, "gpio_line", Unit::kCount, 0, 1023, "GPIO line offset of the buzzer");
+    v.num(min_cue_interval, "min_cue_interval_s", Unit::kSecond, 0, 60, "shortest gap between two cues of one kind");
+    v.num(announce_distance, "announce_distance_m", Unit::kMetre, 0.2, 20, "announce stairs nearer than this");
+  }
+};
+
+/// The whole pipeline's configuration, as in config/stairguide.yaml.
+struct PipelineConfig {
+  CaptureConfig capture;
+  SegmentationConfig segmentation;
+  FloorConfig floor;
+  ManhattanConfig manhattan;
+  ClassificationConfig classification;
+  StairDetectionConfig stair_detection;
+  StairModellingConfig stair_modelling;
+  OdometryConfig odometry;
+  RuntimeConfig runtime;
+  FeedbackConfig feedback;
+
+  template <class V> void visit(V& v) {
+    v.section("capture", "camera and recording input", capture);
+    v.section("segmentation", "plane segmentation (paper 3.1)", segmentation);
+    v.section("floor", "camera-to-floor transform (paper 3.2.1)", floor);
+    v.section("manhattan", "floor-to-Manhattan transform (paper 3.2.2)", manhattan);
+    v.section("classification", "classification of regions (paper 3.3)", classification);
+    v.section("stair_detection", "stair detection (paper 4.1)", stair_detection);
+    v.section("stair_modelling", "stair modelling and validation (paper 4.2)", stair_modelling);
+    v.section("odometry", "dense RGB-D visual odometry (paper 5.1)", odometry);
+    v.section("runtime", "daemon threads, logging and counters", runtime);
+    v.section("feedback", "audio cues and haptic buzzer", feedback);
+  }
+};
+
+/// Cross-field checks the per-field ranges cannot express (min <= max ...). Returns one message
+/// per problem, naming the keys; empty when the config is consistent.
+std::vector<std::string> check_consistency(const PipelineConfig& c);
+
+/// True when every field of `a` equals the same field of `b` (floats within 1e-6 relative).
+/// On a difference, `first_difference` names the key.
+bool config_equal(const PipelineConfig& a, const PipelineConfig& b, std::string* first_difference = nullptr);
+
+}  // namespace stairguide

@@ -1,0 +1,60 @@
+#pragma once
+/// \file ground_truth.hpp
+/// Ground truth carried by synthetic frames and by labelled dataset folders (`labels.yaml`).
+///
+/// The stair frame S follows the paper's Fig. 8: y_S points up (against gravity), z_S points
+/// along the direction of travel into the staircase (away from the user who approaches it),
+/// x_S = y_S x z_S runs along the step edge (to the user's left). The origin is the centre of
+/// the first step's edge:
+///  - ascending: the front (nosing) edge of the first tread, one riser above the floor;
+///  - descending: the edge where the floor ends and the first drop begins (height 0);
+///  - single step / curb: the edge of the raised (or lowered) surface nearest the user.
+
+#include <string>
+#include <vector>
+
+#include "stairguide/core/types.hpp"
+
+namespace stairguide {
+
+enum class StairKind { kNone, kAscending, kDescending, kSingleStep, kCurb };
+
+/// "none", "ascending", "descending", "single_step", "curb".
+const char* to_string(StairKind k);
+/// Parses the names above; returns false on an unknown name.
+bool parse_stair_kind(const std::string& s, StairKind& out);
+
+/// One staircase (or single step / curb) of a scene, as seen in one frame.
+struct StairTruth {
+  int id = 0;                        ///< index of the staircase in the scene
+  StairKind kind = StairKind::kNone;
+  int steps = 0;                     ///< number of risers
+  float riser_m = 0.f;               ///< m, vertical distance between consecutive treads
+  float tread_m = 0.f;               ///< m, horizontal distance edge to edge
+  float width_m = 0.f;               ///< m
+  bool open_risers = false;
+  Pose T_camera_stair = Pose::Identity();  ///< stair frame S into camera frame C
+  std::vector<int> visible_steps;    ///< 1-based indices of treads with >= 200 visible pixels
+  std::vector<int> visible_pixels;   ///< visible tread pixels, one per entry of visible_steps
+  bool first_edge_visible = false;   ///< the first step's edge is in view (not occluded)
+  bool both_ends_visible = false;    ///< both ends of the first edge are in view (width measurable)
+  int user_step = 0;                 ///< tread the user stands on: 0 = floor before it, k = step k
+};
+
+/// Ground truth of one frame.
+struct FrameTruth {
+  std::uint64_t index = 0;
+  double timestamp = 0.0;           ///< s
+  std::string scene;                ///< preset name
+  Pose T_world_camera = Pose::Identity();  ///< world: z up, origin on the floor
+  float camera_height_m = 0.f;      ///< m above the floor the user stands on
+  float camera_tilt_rad = 0.f;      ///< rad, optical axis below horizontal
+  float camera_roll_rad = 0.f;      ///< rad
+  bool floor_visible = false;       ///< >= 5% of pixels see the floor the user stands on
+  std::vector<StairTruth> stairs;   ///< staircases in the scene (visible or not)
+
+  /// Staircases with at least one visible step or a visible first edge.
+  bool any_stair_visible() const;
+};
+
+}  // namespace stairguide

@@ -1,0 +1,111 @@
+#include "stairguide/core/config.hpp"
+
+#include <cmath>
+#include <initializer_list>
+#include <string>
+#include <type_traits>
+
+namespace stairguide {
+
+double unit_to_si(Unit u) {
+  switch (u) {
+    case Unit::kCentimetre: return 0.01;
+    case Unit::kMillimetre: return 0.001;
+    case Unit::kDegree: return M_PI / 180.0;
+    case Unit::kPercent: return 0.01;
+    case Unit::kMillisecond: return 0.001;
+    default: return 1.0;
+  }
+}
+
+const char* unit_name(Unit u) {
+  switch (u) {
+    case Unit::kMetre: return "m";
+    case Unit::kCentimetre: return "cm";
+    case Unit::kMillimetre: return "mm";
+    case Unit::kDegree: return "deg";
+    case Unit::kPercent: return "%";
+    case Unit::kSecond: return "s";
+    case Unit::kMillisecond: return "ms";
+    case Unit::kHertz: return "Hz";
+    case Unit::kPerMetre: return "1/m";
+    case Unit::kPixel: return "px";
+    case Unit::kCount: return "";
+    case Unit::kNone: return "";
+  }
+  return "";
+}
+
+namespace {
+
+/// Walks two configs side by side; `b_fields` holds b's values in visit order.
+struct Collector {
+  std::vector<double> nums;
+  std::vector<std::string> texts;
+  template <class T> void num(T& f, const char*, Unit, double, double, const char*) {
+    nums.push_back(static_cast<double>(f));
+  }
+  void flag(bool& f, const char*, const char*) { nums.push_back(f ? 1.0 : 0.0); }
+  void text(std::string& f, const char*, std::initializer_list<const char*>, const char*) {
+    texts.push_back(f);
+  }
+  template <class S> void section(const char*, const char*, S& s) { s.visit(*this); }
+};
+
+struct Comparer {
+  const Collector& other;
+  std::string prefix;
+  std::size_t ni = 0, ti = 0;
+  std::string diff;
+  template <class T> void num(T& f, const char* key, Unit, double, double, const char*) {
+    const double a = static_cast<double>(f), b = other.nums[ni++];
+    const bool same = std::is_floating_point<T>::value
+                          ? std::fabs(a - b) <= 1e-6 * std::max(1.0, std::max(std::fabs(a), std::fabs(b)))
+                          : a == b;
+    if (!same && diff.empty()) diff = prefix + key;
+  }
+  void flag(bool& f, const char* key, const char*) {
+    if ((f ? 1.0 : 0.0) != other.nums[ni++] && diff.empty()) diff = prefix + key;
+  }
+  void text(std::string& f, const char* key, std::initializer_list<const char*>, const char*) {
+    if (f != other.texts[ti++] && diff.empty()) diff = prefix + key;
+  }
+  template <class S> void section(const char* name, const char*, S& s) {
+    const std::string saved = prefix;
+    prefix = saved + name + ".";
+    s.visit(*this);
+    prefix = saved;
+  }
+};
+
+}  // namespace
+
+bool config_equal(const PipelineConfig& a, const PipelineConfig& b, std::string* first_difference) {
+  Collector cb;
+  const_cast<PipelineConfig&>(b).visit(cb);
+  Comparer cmp{cb, "", 0, 0, {}};
+  const_cast<PipelineConfig&>(a).visit(cmp);
+  if (first_difference) *first_difference = cmp.diff;
+  return cmp.diff.empty();
+}
+
+std::vector<std::string> check_consistency(const PipelineConfig& c) {
+  std::vector<std::string> out;
+  auto order = [&](double lo, double hi, const char* klo, const char* khi) {
+    if (lo > hi) out.push_back(std::string(klo) + " must not exceed " + khi);
+  };
+  order(c.capture.min_range, c.capture.max_range, "capture.min_range_m", "capture.max_range_m");
+  order(c.capture.retry_min, c.capture.retry_max, "capture.retry_min_s", "capture.retry_max_s");
+  order(c.floor.tilt_min, c.floor.tilt_max, "floor.tilt_min_deg", "floor.tilt_max_deg");
+  order(c.floor.height_min, c.floor.height_max, "floor.height_min_m", "floor.height_max_m");
+  order(c.floor.search_start, c.floor.search_max, "floor.search_start_m", "floor.search_max_m");
+  order(c.classification.step_height_min, c.classification.step_height_max,
+        "classification.step_height_min_cm", "classification.step_height_max_cm");
+  order(c.stair_modelling.riser_min, c.stair_modelling.riser_max, "stair_modelling.riser_min_cm",
+        "stair_modelling.riser_max_cm");
+  order(c.stair_modelling.blondel_min, c.stair_modelling.blondel_max, "stair_modelling.blondel_min_cm",
+        "stair_modelling.blondel_max_cm");
+  return out;
+}
+
+}  // namespace stairguide
