@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli/command.hpp"
-#include "stairguide/runtime/config_loader.hpp"
+#include "stairguide/config/config_loader.hpp"
 
 namespace stairguide::cli {
 

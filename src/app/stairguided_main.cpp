@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <string>
 
-#include "stairguide/runtime/config_loader.hpp"
+#include "stairguide/config/config_loader.hpp"
 
 int main(int argc, char** argv) {
   using namespace stairguide;

@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "cli/command.hpp"
-#include "stairguide/runtime/config_loader.hpp"
+#include "stairguide/config/config_loader.hpp"
 
 namespace stairguide::cli {
 namespace {

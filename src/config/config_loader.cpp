@@ -1,4 +1,4 @@
-#include "stairguide/runtime/config_loader.hpp"
+#include "stairguide/config/config_loader.hpp"
 
 #include <yaml-cpp/yaml.h>
 
