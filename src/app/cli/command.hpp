@@ -54,3 +54,17 @@ struct Registrar {
   static const ::stairguide::cli::Registrar SG_COMMAND_CAT(sg_cmd_, __LINE__)({name, usage, summary, fn})
 
 }  // namespace stairguide::cli
+
+namespace stairguide::cli {
+
+/// `stairguide bench WHAT`: each benchmark registers itself like a command.
+std::vector<Command>& bench_registry();
+
+struct BenchRegistrar {
+  explicit BenchRegistrar(const Command& c) { bench_registry().push_back(c); }
+};
+
+#define SG_BENCH(name, usage, summary, fn) \
+  static const ::stairguide::cli::BenchRegistrar SG_COMMAND_CAT(sg_bench_, __LINE__)({name, usage, summary, fn})
+
+}  // namespace stairguide::cli
