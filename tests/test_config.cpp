@@ -1,0 +1,157 @@
+// Config loader: the shipped file, and each kind of invalid input with file, line and key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "stairguide/config/config_loader.hpp"
+
+using namespace stairguide;
+
+namespace {
+
+const std::string kShipped = std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml";
+
+std::string write_tmp(const std::string& name, const std::string& text) {
+  const std::string path = std::string(STAIRGUIDE_BINARY_DIR) + "/test_config_" + name + ".yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// Loads text that must fail and returns the message.
+std::string error_of(const std::string& name, const std::string& text) {
+  const std::string path = write_tmp(name, text);
+  try {
+    load_config(path);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for " << name;
+  return "";
+}
+
+}  // namespace
+
+TEST(Config, ShippedFileEqualsStructDefaultsAndNamesEveryKey) {
+  ConfigLoadReport report;
+  const PipelineConfig loaded = load_config(kShipped, &report);
+  std::string diff;
+  EXPECT_TRUE(config_equal(loaded, PipelineConfig{}, &diff)) << "first difference: " << diff;
+  EXPECT_TRUE(report.missing_keys.empty()) << "shipped file lacks " << report.missing_keys.front();
+}
+
+TEST(Config, PaperValuesAreTheDefaults) {
+  const PipelineConfig c;
+  EXPECT_FLOAT_EQ(c.segmentation.voxel_size, 0.04f);
+  EXPECT_FLOAT_EQ(c.segmentation.normal_radius, 0.05f);
+  EXPECT_NEAR(c.segmentation.region_angle, 6.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(c.segmentation.region_curvature, 0.5f);
+  EXPECT_EQ(c.segmentation.region_min_points, 50);
+  EXPECT_FLOAT_EQ(c.segmentation.planarity_min_inliers, 0.8f);
+  EXPECT_NEAR(c.floor.tilt_min, 20.0 * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(c.floor.tilt_max, 70.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(c.floor.height_min, 1.0f);
+  EXPECT_FLOAT_EQ(c.floor.height_max, 1.6f);
+  EXPECT_NEAR(c.classification.parallel_threshold, 10.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(c.classification.step_height_min, 0.13f);
+  EXPECT_FLOAT_EQ(c.classification.step_height_max, 0.185f);
+  EXPECT_FLOAT_EQ(c.stair_detection.same_level_tolerance, 0.03f);
+  EXPECT_FLOAT_EQ(c.stair_detection.connection_radius, 0.5f);
+  EXPECT_EQ(c.stair_detection.connection_min_points, 10);
+  EXPECT_FLOAT_EQ(c.odometry.sigma_intensity, 5.0f);
+  EXPECT_FLOAT_EQ(c.odometry.sigma_inv_depth, 0.0025f);
+  EXPECT_FLOAT_EQ(c.odometry.student_nu, 5.0f);
+  EXPECT_EQ(c.odometry.pyramid_levels, 3);
+  EXPECT_EQ(c.odometry.iterations, 10);
+}
+
+TEST(Config, UnitsAreConvertedToSi) {
+  const PipelineConfig c = load_config_text(
+      "segmentation:\n  voxel_size_cm: 3\nfloor:\n  tilt_min_deg: 30\nodometry:\n  min_valid_percent: 10\n",
+      "inline.yaml");
+  EXPECT_FLOAT_EQ(c.segmentation.voxel_size, 0.03f);
+  EXPECT_NEAR(c.floor.tilt_min, 30.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(c.odometry.min_valid_fraction, 0.10f);
+  // Untouched keys keep their defaults.
+  EXPECT_FLOAT_EQ(c.segmentation.normal_radius, 0.05f);
+}
+
+TEST(Config, DumpLoadsBackEqual) {
+  PipelineConfig c;
+  c.segmentation.voxel_size = 0.025f;
+  c.odometry.iterations = 7;
+  c.runtime.log_level = "debug";
+  c.feedback.haptic_enabled = false;
+  const PipelineConfig back = load_config_text(dump_config_yaml(c), "dump.yaml");
+  std::string diff;
+  EXPECT_TRUE(config_equal(back, c, &diff)) << diff;
+  EXPECT_FALSE(config_equal(back, PipelineConfig{}, &diff));
+  EXPECT_EQ(diff, "segmentation.voxel_size_cm");
+}
+
+TEST(Config, UnknownKeyNamesFileLineAndKey) {
+  const std::string e = error_of("unknown", "floor:\n  tilt_min_deg: 20\n  tilt_mni_deg: 30\n");
+  EXPECT_NE(e.find("test_config_unknown.yaml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("floor.tilt_mni_deg"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+}
+
+TEST(Config, UnknownSectionIsRejected) {
+  const std::string e = error_of("section", "flor:\n  tilt_min_deg: 20\n");
+  EXPECT_NE(e.find(":1"), std::string::npos) << e;
+  EXPECT_NE(e.find("'flor'"), std::string::npos) << e;
+}
+
+TEST(Config, WrongTypeNamesFileLineAndKey) {
+  std::string e = error_of("type", "segmentation:\n  voxel_size_cm: four\n");
+  EXPECT_NE(e.find("test_config_type.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("segmentation.voxel_size_cm"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected a number"), std::string::npos) << e;
+  e = error_of("int", "odometry:\n  iterations: 2.5\n");
+  EXPECT_NE(e.find("odometry.iterations"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole number"), std::string::npos) << e;
+  e = error_of("bool", "capture:\n  mirroring: maybe\n");
+  EXPECT_NE(e.find("capture.mirroring"), std::string::npos) << e;
+  e = error_of("list", "floor:\n  height_min_m: [1, 2]\n");
+  EXPECT_NE(e.find("floor.height_min_m"), std::string::npos) << e;
+  e = error_of("choice", "runtime:\n  log_level: loud\n");
+  EXPECT_NE(e.find("runtime.log_level"), std::string::npos) << e;
+  EXPECT_NE(e.find("not one of"), std::string::npos) << e;
+}
+
+TEST(Config, OutOfRangeNamesFileLineKeyAndRange) {
+  const std::string e = error_of("range", "# comment\nfloor:\n  tilt_max_deg: 120\n");
+  EXPECT_NE(e.find("test_config_range.yaml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("floor.tilt_max_deg"), std::string::npos) << e;
+  EXPECT_NE(e.find("out of range [0, 90] deg"), std::string::npos) << e;
+}
+
+TEST(Config, InconsistentPairIsRejected) {
+  const std::string e = error_of("order", "floor:\n  height_min_m: 1.5\n  height_max_m: 1.2\n");
+  EXPECT_NE(e.find("floor.height_min_m"), std::string::npos) << e;
+  EXPECT_NE(e.find("floor.height_max_m"), std::string::npos) << e;
+}
+
+TEST(Config, MissingFileIsNamed) {
+  const std::string path = std::string(STAIRGUIDE_BINARY_DIR) + "/no_such_config.yaml";
+  try {
+    load_config(path);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_config(STAIRGUIDE_BINARY_DIR), ConfigError);  // a directory
+}
+
+TEST(Config, YamlSyntaxErrorHasLine) {
+  const std::string e = error_of("syntax", "floor:\n  tilt_min_deg: 20\n  tilt_max_deg: [70\n");
+  EXPECT_NE(e.find("test_config_syntax.yaml:"), std::string::npos) << e;
+  EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
+}
+
+TEST(Config, EmptyFileGivesDefaults) {
+  const PipelineConfig c = load_config(write_tmp("empty", "# nothing\n"));
+  EXPECT_TRUE(config_equal(c, PipelineConfig{}));
+}
