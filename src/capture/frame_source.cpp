@@ -1,0 +1,75 @@
+// open_frame_source: the one place that maps an input name to a source.
+#include "stairguide/capture/frame_source.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "capture_util.hpp"
+#include "stairguide/capture/dataset.hpp"
+#include "stairguide/capture/device.hpp"
+#include "stairguide/capture/oni.hpp"
+#include "stairguide/capture/synthetic.hpp"
+
+namespace fs = std::filesystem;
+
+namespace stairguide {
+namespace {
+
+long parse_count(const std::string& s, const std::string& input, const char* what) {
+  double v = 0.0;
+  if (!parse_double(s, v) || v != std::floor(v) || v < 0 || v > 4e9)
+    throw SourceError("input '" + input + "': " + what + " must be a whole number, got '" + s + "'");
+  return static_cast<long>(v);
+}
+
+std::unique_ptr<FrameSource> open_synth(const std::string& input) {
+  // synth:SCENE[:FRAMES[:SEED]]
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t c = input.find(':', start);
+    parts.push_back(input.substr(start, c == std::string::npos ? std::string::npos : c - start));
+    if (c == std::string::npos) break;
+    start = c + 1;
+  }
+  if (parts.size() < 2 || parts.size() > 4 || parts[1].empty())
+    throw SourceError("input '" + input +
+                      "': expected synth:SCENE[:FRAMES[:SEED]] (see 'stairguide synth --list')");
+  long frames = -1;
+  for (const auto& p : synth::presets())
+    if (p.name == parts[1]) frames = p.default_frames;
+  if (parts.size() >= 3 && !parts[2].empty()) frames = parse_count(parts[2], input, "FRAMES");
+  if (frames == 0) throw SourceError("input '" + input + "': FRAMES must be at least 1");
+  std::uint32_t seed = 1;
+  if (parts.size() == 4) seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
+  // An unknown scene name is reported by make_source (its message lists the presets).
+  return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed);
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> open_frame_source(const std::string& input, const CaptureConfig& config) {
+  if (input.empty())
+    throw SourceError(
+        "no input given (a dataset folder, FILE.oni, FILE.pcd, FILE.png, device[:URI] or synth:SCENE)");
+  if (input.rfind("synth:", 0) == 0) return open_synth(input);
+  if (input == "device") return std::make_unique<DeviceSource>(config);
+  if (input.rfind("device:", 0) == 0) return std::make_unique<DeviceSource>(config, input.substr(7));
+  std::error_code ec;
+  const std::string ext = lower_extension(input);
+  if (fs::is_directory(input, ec)) return std::make_unique<DatasetSource>(input);
+  if (ext == ".oni") {
+    OniOptions o;
+    o.depth_registration = config.depth_registration;
+    return std::make_unique<OniSource>(input, o);
+  }
+  if (ext == ".pcd") return std::make_unique<SingleFrameSource>(read_pcd_frame(input), "pcd " + input);
+  if (ext == ".png")
+    return std::make_unique<SingleFrameSource>(read_depth_png_frame(input), "depth image " + input);
+  if (!fs::exists(input, ec)) throw SourceError("input '" + input + "': no such file or directory");
+  throw SourceError("input '" + input +
+                    "': unknown kind (expected a dataset folder, FILE.oni, FILE.pcd, FILE.png, device[:URI] "
+                    "or synth:SCENE[:FRAMES[:SEED]])");
+}
+
+}  // namespace stairguide

@@ -1,0 +1,177 @@
+// .oni replay through OpenNI2's own player (see DESIGN.md for the checked facts this relies on).
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+
+#include "capture_util.hpp"
+#include "openni_util.hpp"
+#include "stairguide/capture/oni.hpp"
+
+namespace fs = std::filesystem;
+
+namespace stairguide {
+
+struct OniSource::Impl {
+  std::string path;
+  OniOptions options;
+  openni::Device device;
+  openni::VideoStream depth, color;
+  bool has_color = false;
+  bool registered = false;
+  long depth_frames = 0;  ///< announced by the recording
+  long color_frames = 0;
+  long next = 0;  ///< depth frames delivered so far
+  long color_read = 0;
+  long skipped = 0;
+  int last_depth_number = 0;
+  bool ended = false;
+  CameraIntrinsics k;
+  openni::VideoFrameRef depth_ref, color_ref;
+
+  ~Impl() {
+    // Stop streams before the device goes: the player thread waits on them.
+    if (color.isValid()) {
+      color.stop();
+      color.destroy();
+    }
+    if (depth.isValid()) {
+      depth.stop();
+      depth.destroy();
+    }
+    if (device.isValid()) device.close();
+  }
+
+  // Waits for one frame of `s` (which pokes the manual-mode trigger) and reads it.
+  bool read_one(openni::VideoStream& s, openni::VideoFrameRef& ref, int timeout_ms, std::string& why) {
+    openni::VideoStream* streams[] = {&s};
+    int ready = -1;
+    const openni::Status st = openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms);
+    if (st != openni::STATUS_OK) {
+      why = st == openni::STATUS_TIME_OUT ? "no frame within " + fmt_num(timeout_ms / 1000.0) + " s"
+                                          : openni_error("wait failed");
+      return false;
+    }
+    if (s.readFrame(&ref) != openni::STATUS_OK || !ref.isValid()) {
+      why = openni_error("readFrame failed");
+      return false;
+    }
+    return true;
+  }
+};
+
+OniSource::OniSource(const std::string& path, const OniOptions& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  m.options = options;
+  // OpenNI gives the same status for a missing, corrupt or directory path: check first.
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw SourceError("oni " + path + ": recording missing (no such file)");
+  if (!fs::is_regular_file(path, ec)) throw SourceError("oni " + path + ": not a regular file");
+  if (fs::file_size(path, ec) < 24)
+    throw SourceError("oni " + path + ": too short to be a recording (truncated?)");
+  const std::string init = ensure_openni();
+  if (!init.empty()) throw SourceError("oni " + path + ": OpenNI2 unavailable: " + init);
+  if (m.device.open(path.c_str()) != openni::STATUS_OK)
+    throw SourceError("oni " + path +
+                      ": OpenNI2's player cannot open it (corrupt, truncated or not an .oni recording): " +
+                      openni_error("open failed"));
+  openni::PlaybackControl* pc = m.device.getPlaybackControl();
+  if (!pc) throw SourceError("oni " + path + ": opened, but OpenNI2 gives no playback control");
+  // Manual, frame-exact mode; no wrap-around at the end.
+  pc->setSpeed(-1.0f);
+  pc->setRepeatEnabled(false);
+  if (!m.device.hasSensor(openni::SENSOR_DEPTH) ||
+      m.depth.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK)
+    throw SourceError("oni " + path + ": the recording has no depth stream");
+  m.depth_frames = pc->getNumberOfFrames(m.depth);
+  if (m.depth_frames <= 0) throw SourceError("oni " + path + ": the recording announces no depth frames");
+  if (options.use_color && m.device.hasSensor(openni::SENSOR_COLOR) &&
+      m.color.create(m.device, openni::SENSOR_COLOR) == openni::STATUS_OK) {
+    m.has_color = true;
+    m.color_frames = pc->getNumberOfFrames(m.color);
+  }
+  if (m.has_color && options.depth_registration &&
+      m.device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR))
+    m.registered =
+        m.device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) == openni::STATUS_OK;
+  if (m.depth.start() != openni::STATUS_OK)
+    throw SourceError("oni " + path + ": cannot start the depth stream: " + openni_error(""));
+  if (m.has_color && m.color.start() != openni::STATUS_OK)
+    throw SourceError("oni " + path + ": cannot start the colour stream: " + openni_error(""));
+
+  const openni::VideoMode vm = m.depth.getVideoMode();
+  const int w = vm.getResolutionX(), h = vm.getResolutionY();
+  if (w <= 0 || h <= 0) throw SourceError("oni " + path + ": the depth stream has no resolution");
+  // Registered depth follows the colour camera's geometry, so its field of view applies.
+  const openni::VideoStream& geo = (m.registered && m.has_color) ? m.color : m.depth;
+  const float hfov = geo.getHorizontalFieldOfView(), vfov = geo.getVerticalFieldOfView();
+  if (std::isfinite(hfov) && std::isfinite(vfov) && hfov > 0.05f && hfov < 3.0f && vfov > 0.05f &&
+      vfov < 3.0f)
+    m.k = intrinsics_from_fov(w, h, hfov, vfov);
+  else
+    m.k = default_intrinsics(w, h);
+}
+
+OniSource::~OniSource() = default;
+
+ReadResult OniSource::read(RgbdFrame& out) {
+  Impl& m = *impl_;
+  if (m.ended || m.next >= m.depth_frames) {
+    m.ended = true;
+    return {ReadStatus::kEnd, {}};
+  }
+  const int timeout_ms = std::max(1, static_cast<int>(std::lround(m.options.frame_timeout * 1000.0)));
+  std::string why;
+  // A readFrame past the last frame blocks in manual mode, hence the frame count above; a
+  // recording shorter than it announces (truncated) shows as a wait that times out.
+  if (!m.read_one(m.depth, m.depth_ref, timeout_ms, why)) {
+    m.ended = true;
+    return {ReadStatus::kEnd, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
+                                  " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
+  }
+  if (!depth_frame_to_metres(m.depth_ref, out.depth)) {
+    m.ended = true;
+    return {ReadStatus::kError,
+            "oni " + m.path + ": unsupported depth pixel format " +
+                std::to_string(static_cast<int>(m.depth_ref.getVideoMode().getPixelFormat()))};
+  }
+  const int number = m.depth_ref.getFrameIndex();
+  if (m.last_depth_number > 0 && number > m.last_depth_number + 1)
+    m.skipped += number - m.last_depth_number - 1;
+  m.last_depth_number = number;
+  out.timestamp = static_cast<double>(m.depth_ref.getTimestamp()) * 1e-6;
+  out.color.release();
+  out.gray.release();
+  if (m.has_color && m.color_read < m.color_frames) {
+    if (m.read_one(m.color, m.color_ref, timeout_ms, why)) {
+      ++m.color_read;
+      if (color_frame_to_bgr(m.color_ref, out.color) && out.color.size() != out.depth.size()) {
+        // Unregistered recordings may carry a colour mode of another size: scale it onto depth.
+        cv::Mat resized;
+        cv::resize(out.color, resized, out.depth.size(), 0, 0, cv::INTER_LINEAR);
+        out.color = resized;
+      }
+      if (!out.color.empty()) cv::cvtColor(out.color, out.gray, cv::COLOR_BGR2GRAY);
+    } else {
+      m.color_read = m.color_frames;  // colour ended early: give depth alone from here on
+    }
+  }
+  out.index = static_cast<std::uint64_t>(m.next++);
+  out.intrinsics = m.k;
+  return {};
+}
+
+CameraIntrinsics OniSource::intrinsics() const { return impl_->k; }
+long OniSource::frame_count() const { return impl_->depth_frames; }
+bool OniSource::has_color() const { return impl_->has_color; }
+bool OniSource::registered() const { return impl_->registered; }
+long OniSource::skipped_frames() const { return impl_->skipped; }
+
+std::string OniSource::describe() const {
+  const Impl& m = *impl_;
+  std::string s = "oni " + m.path + " (" + std::to_string(m.depth_frames) + " depth frames";
+  if (m.has_color) s += ", colour" + std::string(m.registered ? ", registered" : "");
+  return s + ")";
+}
+
+}  // namespace stairguide
