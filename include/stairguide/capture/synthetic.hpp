@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "stairguide/capture/frame_source.hpp"
+#include "stairguide/capture/synthetic_render.hpp"
+#include "stairguide/capture/synthetic_scene.hpp"
+#include "stairguide/capture/synthetic_trajectory.hpp"
 
 namespace stairguide::synth {
 
@@ -27,16 +30,68 @@ const std::vector<PresetInfo>& presets();
 
 /// Sensor and trajectory options common to every preset.
 struct SynthOptions {
-  bool noise = true;              ///< Kinect-like depth noise, quantisation, holes
+  bool noise = true;  ///< Kinect-like depth noise, quantisation, holes
   int width = 640;
   int height = 480;
   /// Overrides of the camera mounting; NaN keeps the preset's (seeded) value.
   float camera_height_m = std::numeric_limits<float>::quiet_NaN();
   float camera_tilt_deg = std::numeric_limits<float>::quiet_NaN();
+  float camera_roll_deg = std::numeric_limits<float>::quiet_NaN();
+
+  // ---- sensor model (Kinect v1 class); the range limits apply even with noise off ----
+  float min_range_m = 0.5f;          ///< m, nearer surfaces give no reading
+  float max_range_m = 5.0f;          ///< m, farther surfaces give no reading
+  float grazing_max_deg = 78.f;      ///< deg, incidence beyond this gives no reading
+  float sigma_coeff = 1.425e-3f;     ///< 1/m, depth sigma = sigma_coeff * z^2 (total, all effects)
+  float disparity_focal_px = 580.f;  ///< px, focal length of the sensor's own IR camera (640 wide)
+  float baseline_m = 0.075f;         ///< m, projector-camera baseline
+  float disparity_step_px = 0.125f;  ///< px, disparity quantisation (1/8 px)
+  float depth_step_m = 0.001f;       ///< m, depth rounding of the driver (OpenNI: 1 mm)
+  bool shadows = true;               ///< holes where the projector cannot see (occlusion shadows)
+  float edge_jump_abs_m = 0.02f;     ///< m, a neighbour nearer by more than abs + rel*z ...
+  float edge_jump_rel = 0.04f;       ///< ... makes a pixel a hole (mixed pixels at discontinuities)
+  float dropout = 0.002f;            ///< fraction of valid pixels dropped at random
+  float color_noise = 2.0f;          ///< grey levels, sigma of the colour noise
+  double fps = 30.0;                 ///< Hz, frame rate of the timestamps
 };
 
+/// Everything needed to render one frame of a preset: the scene and the walker's state.
+struct PresetFrame {
+  Scene scene;
+  WalkerState walker;
+};
+
+/// Builds the scene and camera state of frame `index` of `preset` (no rendering). Static presets
+/// draw a new scene and view for every index; sequences keep one scene and follow a trajectory.
+/// Throws SourceError for an unknown preset.
+PresetFrame build_preset_frame(const std::string& preset, long index, std::uint32_t seed,
+                               const SynthOptions& options = {});
+
+/// Ground truth of a rendered frame, read off the ideal render (`ideal`: the noise-free render of
+/// `scene` from `walker.T_world_camera`):
+///  - camera_height_m: camera height above the tread/floor under the user's body (walker.support_z);
+///  - floor_visible: >= 5% of the pixels see, within the sensor's range, an upward surface at that height;
+///  - per staircase: T_camera_stair; visible_steps: treads 1..steps (tread `steps` = the landing or
+///    floor after the last riser) with >= 200 pixels within range; first_edge_visible: an unoccluded
+///    stretch of at least min(0.5 m, half the width) of the first edge is in view and in range (an
+///    edge point is seen when a pixel of its 3x3 neighbourhood has its depth within 1 cm + 1%);
+///    both_ends_visible: both ends (2-3 cm inside) are seen; user_step: tread under the body.
+FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal,
+                         const CameraIntrinsics& K, const SynthOptions& options);
+
+/// Renders frame `index` of `preset` into `frame` (depth, colour, grey, timestamp, intrinsics) and
+/// its ground truth into `truth`. What a synthetic FrameSource does for each read.
+void render_preset_frame(const std::string& preset, long index, std::uint32_t seed,
+                         const SynthOptions& options, RgbdFrame& frame, FrameTruth& truth);
+
+/// Intrinsics of the synthetic camera: fx = fy = 525, cx = 319.5, cy = 239.5 at 640x480,
+/// scaled to options.width x options.height.
+CameraIntrinsics synthetic_intrinsics(const SynthOptions& options);
+
 /// A FrameSource rendering a preset frame by frame; `truth()` gives each frame's ground truth.
-/// Throws SourceError for an unknown preset name (the message lists the known ones).
+/// `frames` <= 0 takes the preset's default_frames; a sequence asked for more frames than its
+/// default holds its final pose. Timestamps are index / fps.
+/// Throws SourceError for an unknown preset name (the message lists the known ones) or bad options.
 std::unique_ptr<FrameSource> make_source(const std::string& preset, long frames, std::uint32_t seed,
                                          const SynthOptions& options = {});
 

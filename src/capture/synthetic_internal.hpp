@@ -1,0 +1,49 @@
+#pragma once
+// Internals shared by the synthetic world's .cpp files (not part of the public API).
+#include <cstdint>
+
+#include "stairguide/capture/synthetic_scene.hpp"
+
+namespace stairguide::synth::detail {
+
+constexpr int kTextureSize = 256;  // texels per side; every texture tiles with this period
+
+// Zero-mean, unit-variance tileable texture of a family (made once, thread-safe).
+const float* texture(Texture t);
+
+// 65536 standard normal deviates (exact zero mean and unit variance), made once.
+const float* gaussian_table();
+constexpr std::uint32_t kGaussianMask = 0xFFFF;
+
+}  // namespace stairguide::synth::detail
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_builders.hpp"
+
+namespace stairguide::synth::detail {
+
+// What a preset builds: a scene plus either one static view or a walk.
+struct PresetBuild {
+  Scene scene;
+  bool sequence = false;
+  WalkerState view;  // static presets
+  WalkSpec walk;     // sequences
+};
+
+struct PresetDef {
+  PresetInfo info;
+  bool sequence = false;
+  // Builds the preset from `rng` (seeded per frame for static presets, per seed for sequences).
+  std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build;
+};
+
+const std::vector<PresetDef>& preset_defs();
+// nullptr when unknown.
+const PresetDef* find_preset(const std::string& name);
+std::uint64_t name_hash(const std::string& s);
+
+}  // namespace stairguide::synth::detail

@@ -1,0 +1,162 @@
+// Kinect-like sensor model. Depth comes from disparity d = F / z (F = IR focal x baseline): the
+// sensor's noise is Gaussian in disparity, the disparity is quantised to 1/8 px and the driver
+// rounds depth to 1 mm. Measured depth sigma is the sum of all three, so the Gaussian part is
+// chosen to make the total equal sigma_coeff * z^2 (Khoshelham & Elberink's 1.425e-3 z^2 is a
+// measured figure that already contains quantisation). Holes follow what a structured-light
+// sensor loses: out of range, grazing incidence, mixed pixels at depth jumps, and the projector's
+// occlusion shadows (projector to the camera's right: shadows fall left of near objects).
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "synthetic_internal.hpp"
+
+namespace stairguide::synth {
+namespace {
+
+// xorshift64*: the per-pixel random stream (fast; the seed fixes the realisation).
+struct Stream {
+  std::uint64_t s;
+  explicit Stream(std::uint64_t seed) : s(seed * 0x9E3779B97F4A7C15ull + 0x2545F4914F6CDD1Dull) {
+    if (s == 0) s = 1;
+  }
+  std::uint64_t next() {
+    s ^= s >> 12;
+    s ^= s << 25;
+    s ^= s >> 27;
+    return s * 0x2545F4914F6CDD1Dull;
+  }
+};
+
+// Round to nearest for non-negative values, without the libm call of std::nearbyint.
+inline float round_pos(float x) { return static_cast<float>(static_cast<int>(x + 0.5f)); }
+
+}  // namespace
+
+float depth_sigma_model(float z, const SynthOptions& o) { return o.sigma_coeff * z * z; }
+
+float disparity_noise_sigma(float z, const SynthOptions& o) {
+  const float F = o.disparity_focal_px * o.baseline_m;
+  const float total = o.sigma_coeff * F;  // px: sigma_z = z^2 / F * sigma_d
+  const float q = o.disparity_step_px;
+  const float mm = o.depth_step_m * F / (z * z);  // depth rounding step, in disparity
+  const float var = total * total - q * q / 12.f - mm * mm / 12.f;
+  return var > 0.f ? std::sqrt(var) : 0.f;
+}
+
+void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& o,
+                        std::uint64_t seed, cv::Mat& depth_out) {
+  const int W = ideal.depth.cols, H = ideal.depth.rows;
+  depth_out.create(H, W, CV_32FC1);
+  const float zmin = o.min_range_m, zmax = o.max_range_m;
+  if (!o.noise) {
+    for (int v = 0; v < H; ++v) {
+      const float* in = ideal.depth.ptr<float>(v);
+      float* out = depth_out.ptr<float>(v);
+      for (int u = 0; u < W; ++u) out[u] = (in[u] >= zmin && in[u] <= zmax) ? in[u] : 0.f;
+    }
+    return;
+  }
+
+  std::vector<unsigned char> hole(static_cast<std::size_t>(W * H), 0);
+  const float cos_graze = std::cos(deg2rad(o.grazing_max_deg));
+  const float shadow_f = K.fx * o.baseline_m;  // shadows use the image's own projection
+  for (int v = 0; v < H; ++v) {
+    const float* z = ideal.depth.ptr<float>(v);
+    const float* zu = v > 0 ? ideal.depth.ptr<float>(v - 1) : nullptr;
+    const float* zd = v + 1 < H ? ideal.depth.ptr<float>(v + 1) : nullptr;
+    const float* ci = ideal.cos_incidence.ptr<float>(v);
+    unsigned char* hr = &hole[static_cast<std::size_t>(v * W)];
+    for (int u = 0; u < W; ++u) {
+      const float zp = z[u];
+      if (zp <= 0.f) continue;
+      if (ci[u] < cos_graze) {
+        hr[u] = 1;
+        continue;
+      }
+      // Mixed pixels: the farther side of a depth jump is lost.
+      const float jump = o.edge_jump_abs_m + o.edge_jump_rel * zp;
+      auto nearer = [&](float zq) { return zq > 0.f && zp - zq > jump; };
+      if ((u > 0 && nearer(z[u - 1])) || (u + 1 < W && nearer(z[u + 1])) || (zu && nearer(zu[u])) ||
+          (zd && nearer(zd[u])))
+        hr[u] = 1;
+    }
+    if (o.shadows) {
+      // A point at column u is lit by the projector ray with coordinate u - f b / z; it is in
+      // shadow when a point to its right already reached a smaller projector coordinate.
+      float run_min = 1e30f;
+      for (int u = W - 1; u >= 0; --u) {
+        if (z[u] <= 0.f) continue;
+        const float key = static_cast<float>(u) - shadow_f / z[u];
+        if (key > run_min + 0.5f) hr[u] = 1;
+        run_min = std::min(run_min, key);
+      }
+    }
+  }
+
+  const float F = o.disparity_focal_px * o.baseline_m;
+  const float q = o.disparity_step_px, inv_q = 1.f / q;
+  const float ds = o.depth_step_m, inv_ds = 1.f / ds;
+  const float* g = detail::gaussian_table();
+  // Gaussian disparity sigma tabulated per centimetre of depth (it varies slowly with z).
+  const int n_sigma = static_cast<int>(zmax * 100.f) + 2;
+  std::vector<float> sigma(static_cast<std::size_t>(n_sigma));
+  for (int i = 0; i < n_sigma; ++i)
+    sigma[static_cast<std::size_t>(i)] =
+        disparity_noise_sigma(std::max(0.005f, 0.01f * static_cast<float>(i)), o);
+  const std::uint64_t drop_threshold = static_cast<std::uint64_t>(std::clamp(o.dropout, 0.f, 1.f) * 65536.f);
+  Stream rng(seed);
+  for (int v = 0; v < H; ++v) {
+    const float* z = ideal.depth.ptr<float>(v);
+    float* out = depth_out.ptr<float>(v);
+    const unsigned char* hr = &hole[static_cast<std::size_t>(v * W)];
+    for (int u = 0; u < W; ++u) {
+      const std::uint64_t r = rng.next();  // one draw per pixel keeps the stream aligned to pixels
+      const float zp = z[u];
+      if (zp < zmin || zp > zmax || hr[u] || ((r >> 16) & 0xFFFF) < drop_threshold) {
+        out[u] = 0.f;
+        continue;
+      }
+      float d =
+          F / zp + sigma[static_cast<std::size_t>(zp * 100.f + 0.5f)] * g[(r >> 48) & detail::kGaussianMask];
+      if (d <= 0.5f * q) {
+        out[u] = 0.f;
+        continue;
+      }
+      d = round_pos(d * inv_q) * q;
+      const float zn = round_pos((F / d) * inv_ds) * ds;
+      out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
+    }
+  }
+}
+
+void apply_color_sensor(const RenderBuffers& ideal, const SynthOptions& o, std::uint64_t seed,
+                        cv::Mat& color_out, cv::Mat& gray_out) {
+  if (!o.noise || o.color_noise <= 0.f) {
+    ideal.color.copyTo(color_out);
+  } else {
+    color_out.create(ideal.color.size(), CV_8UC3);
+    const float* g = detail::gaussian_table();
+    // Integer noise values, so the per-pixel work is a lookup, an add and a clamp.
+    std::vector<short> noise(detail::kGaussianMask + 1);
+    for (std::size_t i = 0; i < noise.size(); ++i)
+      noise[i] = static_cast<short>(std::lround(std::clamp(o.color_noise * g[i], -127.f, 127.f)));
+    Stream rng(seed ^ 0xC0102u);
+    for (int v = 0; v < ideal.color.rows; ++v) {
+      const uchar* in = ideal.color.ptr<uchar>(v);
+      uchar* out = color_out.ptr<uchar>(v);
+      for (int u = 0; u < 3 * ideal.color.cols; u += 3) {
+        const std::uint64_t r = rng.next();
+        for (int c = 0; c < 3; ++c) {
+          const int x = in[u + c] + noise[(r >> (16 * c + 8)) & detail::kGaussianMask];
+          out[u + c] = static_cast<uchar>(x < 0 ? 0 : (x > 255 ? 255 : x));
+        }
+      }
+    }
+  }
+  cv::cvtColor(color_out, gray_out, cv::COLOR_BGR2GRAY);
+}
+
+}  // namespace stairguide::synth
