@@ -1,0 +1,169 @@
+#pragma once
+/// \file segmentation.hpp
+/// Planar segmentation of an organized depth image (paper 3.1), using the image structure instead
+/// of the paper's voxel grid + k-d tree route (which `stairguide bench perception` runs as the
+/// reference). Planes are fitted in inverse depth (1/z linear in the image coordinates; Kinect
+/// noise is constant there), so every test is a fixed number of noise sigmas at any range:
+///  1. cells of `cell_size_px` pixels: a least-squares plane per cell from summed moments; a cell
+///     is planar when its residual is within the noise;
+///  2. region growing over the cell grid (CAPE-like), nearest planar cells first: a neighbour
+///     joins when the region's plane explains its pixels (mean squared residual from moments);
+///  3. pixels of the non-planar cells beside regions (edges, holes) join the neighbouring region
+///     whose plane fits them best;
+///  4. what is left is seeded again from `fine_cell_size_px` cells and grown pixel by pixel with a
+///     plane test and a local-continuity test (thin, far treads; stops at occlusion edges);
+///  5. adjacent regions on one plane are merged; border pixels go to the plane that fits them best;
+///     regions whose residual is not noise-like are dropped; area (pixel footprints on the plane),
+///     principal rectangle, extent and curvature are computed;
+///  6. the remaining pixels (eroded) form obstacle clusters (image connectivity + depth jumps).
+/// No threads; buffers are kept between frames of one size.
+
+#include <cstdint>
+#include <vector>
+
+#include "stairguide/core/config.hpp"
+#include "stairguide/core/types.hpp"
+#include "stairguide/perception/scene.hpp"
+
+namespace stairguide {
+
+/// Running first and second moments of 3D points (double: sums over 10^5 points).
+struct PointMoments {
+  double w = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+  void add(float x, float y, float z, double weight = 1.0) {
+    w += weight;
+    sx += weight * x; sy += weight * y; sz += weight * z;
+    sxx += weight * x * x; sxy += weight * x * y; sxz += weight * x * z;
+    syy += weight * y * y; syz += weight * y * z; szz += weight * z * z;
+  }
+};
+
+/// Moments for a plane fit in inverse depth. A plane n.p + d = 0 seen through a pinhole is linear
+/// in normalised image coordinates: 1/z = a u' + b v' + c with u' = (u-cx)/fx, v' = (v-cy)/fy,
+/// (a, b, c) = -n / d. Kinect noise is sigma_z = k z^2, i.e. a constant k in 1/z, and it lies
+/// along the ray: ordinary least squares on 1/z is therefore unbiased, where a PCA of the 3D
+/// points tilts thin, far planes towards the viewing rays (degrees at 3 m).
+struct InvDepthMoments {
+  double n = 0, su = 0, sv = 0, sw = 0, suu = 0, suv = 0, svv = 0, suw = 0, svw = 0, sww = 0;
+  void add(float u, float v, float w) {
+    n += 1.0; su += u; sv += v; sw += w;
+    suu += double(u) * u; suv += double(u) * v; svv += double(v) * v;
+    suw += double(u) * w; svw += double(v) * w; sww += double(w) * w;
+  }
+  void sub(float u, float v, float w) {
+    n -= 1.0; su -= u; sv -= v; sw -= w;
+    suu -= double(u) * u; suv -= double(u) * v; svv -= double(v) * v;
+    suw -= double(u) * w; svw -= double(v) * w; sww -= double(w) * w;
+  }
+  void add(const InvDepthMoments& o) {
+    n += o.n; su += o.su; sv += o.sv; sw += o.sw; suu += o.suu; suv += o.suv; svv += o.svv;
+    suw += o.suw; svw += o.svw; sww += o.sww;
+  }
+  /// Mean residual in 1/z of these points under the plane 1/z = a u' + b v' + c.
+  double mean_residual(double a, double b, double c) const {
+    return n > 0 ? (sw - a * su - b * sv) / n - c : 0.0;
+  }
+};
+
+/// A plane: unit normal facing the camera (origin), n.p + d = 0 (d > 0: distance of the camera).
+struct PlaneFit {
+  bool ok = false;
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+  float d = 0.f;
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();  ///< centroid (PCA fits; inverse-depth fits: the point at the mean pixel)
+  float a = 0.f, b = 0.f, c = 0.f;  ///< inverse-depth form 1/z = a u' + b v' + c (inverse-depth fits)
+  float rms_w = 0.f;                ///< residual RMS in 1/z (1/m) (inverse-depth fits)
+  Eigen::Vector3f eigenvalues = Eigen::Vector3f::Zero();  ///< ascending variances (PCA fits)
+  Eigen::Matrix3f eigenvectors = Eigen::Matrix3f::Identity();  ///< columns (PCA fits)
+};
+/// Least-squares plane in inverse depth (see InvDepthMoments).
+PlaneFit fit_plane(const InvDepthMoments& m);
+/// PCA plane of 3D points (principal axes, curvature).
+PlaneFit fit_plane_pca(const PointMoments& m);
+
+/// Counters of one segmentation run.
+struct SegmentationStats {
+  int valid_pixels = 0;
+  int planar_cells = 0;
+  int seeds_used = 0;
+  int regions_merged = 0;
+  int border_pixels_moved = 0;  ///< pixels handed to the neighbouring region whose plane fits better
+  /// Milliseconds per step (for `stairguide bench perception`).
+  double backproject_ms = 0, grow_ms = 0, merge_ms = 0, refine_ms = 0, finalize_ms = 0, clusters_ms = 0;
+  int regions_dropped = 0;  ///< grown regions below region_min_pixels or failing the planarity check
+};
+
+/// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
+class Segmentation {
+ public:
+  explicit Segmentation(const SegmentationConfig& config = {});
+
+  /// Segments `frame.depth` (CV_32FC1 metres, 0 = no reading) with `frame.intrinsics`.
+  /// Fills `regions` (ids 0..n-1) and `clusters`, reusing their storage. Returns false (with
+  /// `why`) when the frame has no usable depth.
+  bool run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions, std::vector<ObstacleCluster>& clusters,
+           std::string* why = nullptr);
+
+  /// Per pixel (v*width+u): index of the region, -2 - k for obstacle cluster k, -1 for none.
+  const std::vector<int>& labels() const { return label_; }
+  const SegmentationStats& stats() const { return stats_; }
+  const SegmentationConfig& config() const { return cfg_; }
+
+ private:
+  struct Grow {
+    InvDepthMoments m;
+    PlaneFit plane;
+    double fit_w = 0;
+    int count = 0;
+  };
+  void backproject(const RgbdFrame& frame);
+  void cell_pass(std::vector<Grow>& grows);
+  void seed_pass(int cell, std::vector<Grow>& grows);
+  void grow_region(int region, const std::vector<int>& seed_pixels, Grow& g);
+  void merge_regions(std::vector<Grow>& grows);
+  void refine_borders(std::vector<Grow>& grows);
+  void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
+  void extract_clusters(std::vector<ObstacleCluster>& clusters);
+  /// Inlier tolerance on the perpendicular distance (m) at depth z from a plane at distance d.
+  /// v = p / width without a hardware division (exact for images up to 4096 wide).
+  int row_of(int p) const { return static_cast<int>((static_cast<std::uint64_t>(p) * div_magic_) >> 44); }
+  float tolerance(float z, float d) const {
+    return cfg_.inlier_sigmas * cfg_.depth_noise_coeff * z * (d < 0 ? -d : d) + cfg_.inlier_min_distance;
+  }
+  /// The same tolerance on the inverse-depth residual (1/m).
+  /// Constant: Kinect noise (and disparity quantisation) is constant in 1/z. (A metric floor
+  /// here would turn into a huge slack for planes seen edge-on, d -> 0.)
+  float tolerance_w() const { return cfg_.inlier_sigmas * cfg_.depth_noise_coeff; }
+
+  SegmentationConfig cfg_;
+  CameraIntrinsics K_;
+  int W_ = 0, H_ = 0;
+  std::uint64_t div_magic_ = 0;
+  std::vector<float> z_;           // depth, 0 where no reading (x = u' z, y = v' z)
+  std::vector<float> w_;           // 1/z, 0 where no reading
+  std::vector<float> un_, vn_;     // normalised image coordinates per column / row
+  std::vector<int> label_;
+  std::vector<int> queue_;
+  std::vector<int> seed_pixels_, next_;
+  struct Cell {
+    int u0, v0;
+    float score;
+  };
+  std::vector<Cell> cells_;
+  std::vector<Grow> grows_;
+  struct RegionAcc {
+    double sx = 0, sy = 0, sz = 0, z3 = 0;
+    PointMoments m;
+  };
+  std::vector<RegionAcc> acc_;
+  std::vector<PlaneFit> fits_;
+  int CW_ = 0, CH_ = 0;                  // cell grid
+  std::vector<InvDepthMoments> cell_m_;
+  std::vector<int> cell_label_;
+  std::vector<std::uint8_t> cell_planar_;
+  std::vector<int> order_, offsets_, sorted_;
+  std::vector<std::uint8_t> mask_;
+  SegmentationStats stats_;
+};
+
+}  // namespace stairguide

