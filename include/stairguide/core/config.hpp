@@ -64,6 +64,16 @@ struct SegmentationConfig {
   float planarity_min_inliers = 0.8f;  ///< fraction of a region's points on its RANSAC plane
   float cluster_tolerance = 0.08f;   ///< m, Euclidean clustering distance for non-planar points
   int cluster_min_points = 30;       ///< points in an obstacle cluster
+  // Organized (image-structure) segmentation, the route the pipeline runs; the fields above are
+  // the paper's PCL route, used by the reference pipeline of `stairguide bench perception`.
+  int cell_size_px = 8;              ///< px, edge of the cells whose planes seed region growing
+  int fine_cell_size_px = 4;         ///< px, second seeding pass on what the first left (thin treads)
+  float depth_noise_coeff = 1.425e-3f;  ///< 1/m, depth sigma = coeff * z^2 (Kinect)
+  float inlier_sigmas = 3.0f;        ///< a pixel joins a plane within this many sigmas (perpendicular)
+  float inlier_min_distance = 0.003f;  ///< m, added to the metric tests (region merging)
+  int region_min_pixels = 100;       ///< px, smallest planar region kept
+  int cluster_min_pixels = 200;      ///< px, smallest obstacle cluster kept
+  int points_stride_px = 2;          ///< px, PlaneRegion::points keeps every Nth pixel in u and v
 
   template <class V> void visit(V& v) {
     v.num(voxel_size, "voxel_size_cm", Unit::kCentimetre, 0.5, 20, "voxel grid edge (paper: 3-4 cm)");
@@ -75,6 +85,18 @@ struct SegmentationConfig {
           "a region is planar when this share of it lies on its RANSAC plane");
     v.num(cluster_tolerance, "cluster_tolerance_cm", Unit::kCentimetre, 0.5, 100, "Euclidean clustering distance");
     v.num(cluster_min_points, "cluster_min_points", Unit::kCount, 1, 100000, "smallest obstacle cluster");
+    v.num(cell_size_px, "cell_size_px", Unit::kPixel, 3, 64, "cell edge for the cell plane fits seeding region growing");
+    v.num(fine_cell_size_px, "fine_cell_size_px", Unit::kPixel, 2, 64,
+          "cell edge of the second seeding pass (thin or far treads)");
+    v.num(depth_noise_coeff, "depth_noise_coeff_per_m", Unit::kPerMetre, 1e-5, 0.1,
+          "depth noise sigma = coeff * z^2 (Kinect: 1.425e-3)");
+    v.num(inlier_sigmas, "inlier_sigmas", Unit::kNone, 0.5, 20, "plane inlier test in depth-noise sigmas");
+    v.num(inlier_min_distance, "inlier_min_distance_mm", Unit::kMillimetre, 0, 100,
+          "added to the metric distance tests when merging regions");
+    v.num(region_min_pixels, "region_min_pixels", Unit::kPixel, 10, 1000000, "smallest planar region, pixels");
+    v.num(cluster_min_pixels, "cluster_min_pixels", Unit::kPixel, 10, 1000000, "smallest obstacle cluster, pixels");
+    v.num(points_stride_px, "points_stride_px", Unit::kPixel, 1, 16,
+          "region point lists keep every Nth pixel in both directions");
   }
 };
 
@@ -91,6 +113,7 @@ struct FloorConfig {
   float min_area = 0.25f;         ///< m^2, smallest floor patch
   float track_max_height_jump = 0.08f;  ///< m, change of camera height accepted between frames
   float track_max_angle_jump = 0.17453293f;  ///< rad, change of floor normal accepted between frames
+  float horizontal_tolerance = 0.17453293f;  ///< rad, floor candidates vs the tracked floor normal (10 deg)
 
   template <class V> void visit(V& v) {
     v.num(tilt_min, "tilt_min_deg", Unit::kDegree, 0, 90, "camera pitch below horizontal: lowest");
@@ -107,18 +130,25 @@ struct FloorConfig {
           "camera height change accepted from one frame to the next");
     v.num(track_max_angle_jump, "track_max_angle_jump_deg", Unit::kDegree, 0.5, 90,
           "floor normal change accepted from one frame to the next");
+    v.num(horizontal_tolerance, "horizontal_tolerance_deg", Unit::kDegree, 0.5, 45,
+          "a plane parallel to the floor within this is a second floor candidate (never taken when nearer the camera)");
   }
 };
 
 struct ManhattanConfig {
   float vertical_tolerance = 0.17453293f;  ///< rad, a plane counts as vertical within this (10 deg)
-  float min_points_fraction = 0.05f;       ///< share of points on vertical planes for a Manhattan scene
+  float min_points_fraction = 0.05f;       ///< share of planar area on Manhattan-aligned vertical planes
+  float min_area = 0.03f;                  ///< m^2 of vertical planes needed for a Manhattan frame
+  float cluster_tolerance = 0.08726646f;   ///< rad, vertical normals within this of the mode vote for it (5 deg)
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
           "a plane is vertical within this angle");
     v.num(min_points_fraction, "min_points_percent", Unit::kPercent, 0, 100,
           "share of points on vertical planes needed to call the scene Manhattan");
+    v.num(min_area, "min_area_m2", Unit::kNone, 0, 100, "vertical plane area needed for a Manhattan frame, square metres");
+    v.num(cluster_tolerance, "cluster_tolerance_deg", Unit::kDegree, 0.5, 44,
+          "vertical normals within this of the dominant direction (mod 90 deg) refine it");
   }
 };
 
@@ -127,6 +157,7 @@ struct ClassificationConfig {
   float step_height_min = 0.13f;           ///< m, H_min
   float step_height_max = 0.185f;          ///< m, H_max
   float floor_height_tolerance = 0.04f;    ///< m, a horizontal plane this close to 0 is floor
+  float step_height_tolerance = 0.02f;     ///< m, noise margin below H_min for step candidates
 
   template <class V> void visit(V& v) {
     v.num(parallel_threshold, "parallel_threshold_deg", Unit::kDegree, 0.5, 45,
@@ -135,6 +166,8 @@ struct ClassificationConfig {
     v.num(step_height_max, "step_height_max_cm", Unit::kCentimetre, 1, 100, "H_max, highest step riser");
     v.num(floor_height_tolerance, "floor_height_tolerance_cm", Unit::kCentimetre, 0.5, 50,
           "a horizontal plane within this of the floor is floor");
+    v.num(step_height_tolerance, "step_height_tolerance_cm", Unit::kCentimetre, 0, 10,
+          "measurement margin: |H| >= H_min - this makes a step candidate");
   }
 };
 
@@ -142,12 +175,30 @@ struct StairDetectionConfig {
   float same_level_tolerance = 0.03f;  ///< m, candidates within this height form one level
   float connection_radius = 0.5f;      ///< m, neighbour search radius between regions
   int connection_min_points = 10;      ///< points within the radius for a connection
+  float height_tolerance = 0.02f;      ///< m, measurement slack on the H_min..H_max riser range
+  int connection_max_points = 256;     ///< points per region used for the connection test (subsampled)
+  float curb_height_min = 0.10f;       ///< m, lowest curb (a single level may be lower than H_min)
+  float single_min_width = 0.8f;       ///< m, a single level narrower than this is an obstacle
+  float single_min_depth = 0.7f;       ///< m, a single level shallower than this is an obstacle
+  float curb_min_depth = 2.6f;         ///< m, a single raised level deeper than this is another floor (curb)
 
   template <class V> void visit(V& v) {
     v.num(same_level_tolerance, "same_level_tolerance_cm", Unit::kCentimetre, 0.5, 20,
           "candidates within this height are one level");
     v.num(connection_radius, "connection_radius_m", Unit::kMetre, 0.05, 5, "neighbour search radius between regions");
     v.num(connection_min_points, "connection_min_points", Unit::kCount, 1, 100000, "points within the radius to connect");
+    v.num(height_tolerance, "height_tolerance_cm", Unit::kCentimetre, 0, 10,
+          "measurement slack on the H_min..H_max range between levels");
+    v.num(connection_max_points, "connection_max_points", Unit::kCount, 16, 100000,
+          "points per region used in the connection test (evenly subsampled)");
+    v.num(curb_height_min, "curb_height_min_cm", Unit::kCentimetre, 1, 100,
+          "lowest curb: a single level this far above or below the floor may be a curb");
+    v.num(single_min_width, "single_min_width_m", Unit::kMetre, 0.05, 10,
+          "a single level narrower than this is an obstacle, not a step (half of it when cut by the image border)");
+    v.num(single_min_depth, "single_min_depth_m", Unit::kMetre, 0.05, 10,
+          "a single level shallower than this is an obstacle, not a step");
+    v.num(curb_min_depth, "curb_min_depth_m", Unit::kMetre, 0.1, 100,
+          "a single raised level deeper than this, or running out of view on both sides, is another floor level (a curb)");
   }
 };
 
@@ -159,6 +210,9 @@ struct StairModellingConfig {
   float blondel_max = 0.70f;      ///< m, 2R + T upper bound
   float width_min = 0.6f;         ///< m
   float manhattan_min_fraction = 0.1f;  ///< share of Manhattan points to use the Manhattan axes
+  float manhattan_max_disagreement = 0.08726646f;  ///< rad, Manhattan axes used only within this of the steps' own axes (5 deg)
+  float dimension_tolerance = 0.01f;    ///< m, measurement slack on the building-code limits
+  float edge_max_residual = 0.06f;      ///< m, largest deviation of a step edge from even spacing
 
   template <class V> void visit(V& v) {
     v.num(riser_min, "riser_min_cm", Unit::kCentimetre, 1, 100, "building code: lowest riser");
@@ -169,6 +223,12 @@ struct StairModellingConfig {
     v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "narrowest staircase");
     v.num(manhattan_min_fraction, "manhattan_min_percent", Unit::kPercent, 0, 100,
           "share of Manhattan points needed to take the stair axes from the Manhattan frame");
+    v.num(manhattan_max_disagreement, "manhattan_max_disagreement_deg", Unit::kDegree, 0, 45,
+          "Manhattan axes are used only when within this of the steps' own (PCA) axes");
+    v.num(dimension_tolerance, "dimension_tolerance_cm", Unit::kCentimetre, 0, 10,
+          "measurement slack on the building-code limits");
+    v.num(edge_max_residual, "edge_max_residual_cm", Unit::kCentimetre, 0.5, 50,
+          "largest deviation of a step edge from evenly spaced edges");
   }
 };
 
@@ -176,23 +236,42 @@ struct OdometryConfig {
   float sigma_intensity = 5.0f;     ///< intensity units (0-255), photometric residual scale
   float sigma_inv_depth = 0.0025f;  ///< 1/m, inverse-depth residual scale
   float student_nu = 5.0f;          ///< Student-t degrees of freedom
-  int pyramid_levels = 3;
+  int pyramid_levels = 5;           ///< paper: 3; 5 (down to 40x30 px at VGA) tracks 14 cm / 7 deg per frame
   int iterations = 10;              ///< per pyramid level
   float min_valid_fraction = 0.05f; ///< share of pixels with depth needed to track
   float max_translation = 0.3f;     ///< m per frame beyond which the estimate is a failure
   float max_rotation = 0.35f;       ///< rad per frame beyond which the estimate is a failure
   int threads = 1;                  ///< 1 or 2 threads over image rows
+  int max_points_per_level = 20000; ///< pixels per pyramid level (a level with more is subsampled on a grid)
+  float max_inv_depth_step = 0.05f; ///< fraction of W between neighbouring full-res pixels = depth edge
+  float min_update_translation = 1e-4f;  ///< m, an update below this (and the rotation one) = converged
+  float min_update_rotation = 1.745e-4f; ///< rad (0.01 deg)
+  float min_inlier_fraction = 0.5f; ///< share of used pixels with both residuals within 3 sigma
+  bool adaptive_scale = true;       ///< weight scales follow the residuals while above sigma_I / sigma_W
 
   template <class V> void visit(V& v) {
     v.num(sigma_intensity, "sigma_intensity", Unit::kNone, 0.01, 255, "photometric scale sigma_I, grey levels 0-255");
     v.num(sigma_inv_depth, "sigma_inv_depth_per_m", Unit::kPerMetre, 1e-6, 1, "inverse-depth scale sigma_W, 1/m");
     v.num(student_nu, "student_nu", Unit::kNone, 1, 100, "Student-t degrees of freedom (weights (nu+1)/(nu+x^2))");
-    v.num(pyramid_levels, "pyramid_levels", Unit::kCount, 1, 6, "image pyramid levels, coarse to fine");
+    v.num(pyramid_levels, "pyramid_levels", Unit::kCount, 1, 6,
+          "image pyramid levels, coarse to fine (paper: 3; two more coarse ones cost little and catch 14 cm / 7 deg)");
     v.num(iterations, "iterations", Unit::kCount, 1, 100, "Gauss-Newton iterations per level");
     v.num(min_valid_fraction, "min_valid_percent", Unit::kPercent, 0.1, 100, "pixels with depth needed to track");
     v.num(max_translation, "max_translation_cm", Unit::kCentimetre, 1, 500, "motion per frame beyond walking = failure");
     v.num(max_rotation, "max_rotation_deg", Unit::kDegree, 1, 180, "rotation per frame beyond walking = failure");
     v.num(threads, "threads", Unit::kCount, 1, 2, "threads over image rows");
+    v.num(max_points_per_level, "max_points_per_level", Unit::kCount, 500, 10000000,
+          "pixels used per pyramid level; a level with more is subsampled on a regular grid");
+    v.num(max_inv_depth_step, "max_inv_depth_step_percent", Unit::kPercent, 0.5, 100,
+          "inverse-depth change between neighbouring full-resolution pixels treated as a depth edge");
+    v.num(min_update_translation, "min_update_translation_mm", Unit::kMillimetre, 0.001, 100,
+          "a level stops when its update moves less than this and turns less than min_update_rotation");
+    v.num(min_update_rotation, "min_update_rotation_deg", Unit::kDegree, 0.0001, 10,
+          "a level stops when its update turns less than this and moves less than min_update_translation");
+    v.num(min_inlier_fraction, "min_inlier_percent", Unit::kPercent, 0, 100,
+          "share of used pixels whose residuals are within 3 sigma, below which the estimate is a failure");
+    v.flag(adaptive_scale, "adaptive_scale",
+           "far from the solution, scale the Student-t weights by the residuals' own spread (never below sigma_I, sigma_W)");
   }
 };
 
