@@ -1,0 +1,34 @@
+#pragma once
+/// \file latency.hpp
+/// Fixed-memory latency histogram (0.1 ms bins up to 2 s, one overflow bin) giving percentiles
+/// exact to a bin, over a run of any length. Not thread-safe.
+
+#include <cstdint>
+#include <vector>
+
+namespace stairguide::runtime {
+
+class LatencyHistogram {
+ public:
+  static constexpr double kBinMs = 0.1;
+  static constexpr int kBins = 20000;  ///< 0 .. 2000 ms
+
+  LatencyHistogram() : bins_(kBins + 1, 0) {}
+
+  void add(double ms);
+  void clear();
+  std::uint64_t count() const { return count_; }
+  /// Percentile `p` in [0, 100] in ms (the upper edge of its bin, or the maximum seen for the
+  /// overflow bin); 0 when empty.
+  double percentile(double p) const;
+  double max() const { return max_; }
+  double mean() const { return count_ ? sum_ / static_cast<double>(count_) : 0.0; }
+
+ private:
+  std::vector<std::uint32_t> bins_;
+  std::uint64_t count_ = 0;
+  double sum_ = 0.0;
+  double max_ = 0.0;
+};
+
+}  // namespace stairguide::runtime

@@ -1,0 +1,121 @@
+#pragma once
+/// \file pipeline.hpp
+/// The stages the daemon runs, behind one small interface each, so that the threaded runtime and
+/// the synchronous (one thread, in order) mode drive exactly the same code.
+///
+/// - `OdometryStage::step(frame)`: dense RGB-D odometry on every frame (odometry room).
+/// - `PerceptionStage::step(frame, pose)`: segmentation, floor, Manhattan frame, classification
+///   (perception room) -> stair detection and modelling (stairs room) -> traversal.
+/// - `FeedbackStage::decide(perception, odometry)`: the cue decision (feedback room).
+///
+/// Each stage wraps whatever the library provides; a room the library does not have yet is
+/// reported by `available()` = false and `describe()` (a seam, never a fake result). Stages are
+/// not thread-safe: each is driven by one thread. `reconfigure()` is called by that same thread
+/// between two frames.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "stairguide/core/config.hpp"
+#include "stairguide/core/types.hpp"
+
+namespace stairguide::runtime {
+
+/// What odometry made of one frame.
+struct OdometryOutput {
+  std::uint64_t seq = 0;  ///< runtime frame number (0-based, in capture order)
+  bool ran = false;       ///< false: this build has no odometry stage
+  bool ok = false;        ///< estimate trusted (see `status`)
+  std::string status;     ///< "ok", "first frame", or why not (short, no spaces: for the frame lines)
+  Pose T_world_camera = Pose::Identity();  ///< accumulated pose C0 -> Ck
+  double ms = 0.0;                         ///< time spent in the stage
+};
+
+/// What perception (and the stair stages behind it) made of one frame.
+struct PerceptionOutput {
+  std::uint64_t seq = 0;  ///< runtime frame number
+  bool ran = false;       ///< false: this build has no perception stage
+  bool floor_found = false;
+  bool stair_detected = false;
+  /// One token for the frame lines: "no_floor", "floor", "ascending", "descending",
+  /// "single_step", "curb" (a detection), or "none" without a perception stage.
+  std::string state;
+  std::string detail;  ///< human-readable: why no floor / no stair, levels, riser...
+  int levels = 0;      ///< stair levels in view (0 without a detection)
+  double ms = 0.0;     ///< time spent in the stages
+};
+
+/// The feedback decision for one perceived frame.
+struct Decision {
+  std::string state;     ///< the state the user is in, as told ("none", "ascending", ...)
+  bool changed = false;  ///< differs from the previous decision
+  std::string cue;       ///< cue emitted for this frame, empty when none (or no feedback stage)
+};
+
+/// Dense odometry on every frame.
+class OdometryStage {
+ public:
+  explicit OdometryStage(const PipelineConfig& config);
+  ~OdometryStage();
+  OdometryStage(const OdometryStage&) = delete;
+  OdometryStage& operator=(const OdometryStage&) = delete;
+
+  OdometryOutput step(const RgbdFrame& frame);
+  /// Applies a new config; the odometry keeps its pose but restarts from the next frame.
+  void reconfigure(const PipelineConfig& config);
+  /// After a camera reconnect: the next frame starts a new track from the last pose.
+  void restart();
+  bool available() const;
+  std::string describe() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Segmentation -> floor -> Manhattan -> classification -> stair detection/modelling -> traversal.
+class PerceptionStage {
+ public:
+  explicit PerceptionStage(const PipelineConfig& config);
+  ~PerceptionStage();
+  PerceptionStage(const PerceptionStage&) = delete;
+  PerceptionStage& operator=(const PerceptionStage&) = delete;
+
+  /// `T_world_camera` is the latest odometry pose (possibly of an earlier frame), or null.
+  PerceptionOutput step(const RgbdFrame& frame, const Pose* T_world_camera);
+  void reconfigure(const PipelineConfig& config);
+  bool available() const;
+  std::string describe() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Turns perceived states into cues for the user.
+class FeedbackStage {
+ public:
+  explicit FeedbackStage(const PipelineConfig& config);
+  ~FeedbackStage();
+  FeedbackStage(const FeedbackStage&) = delete;
+  FeedbackStage& operator=(const FeedbackStage&) = delete;
+
+  Decision decide(const PerceptionOutput& perception, const OdometryOutput* latest_odometry);
+  /// The camera stopped sending (`why` names it) / is back: the user must be told.
+  void camera_lost(const std::string& why);
+  void camera_back();
+  void reconfigure(const PipelineConfig& config);
+  bool available() const;
+  std::string describe() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One line naming the stage implementations compiled into this build, e.g.
+/// "odometry=DenseOdometry perception=none(seam) ...".
+std::string describe_stages(const PipelineConfig& config);
+
+}  // namespace stairguide::runtime

@@ -1,0 +1,165 @@
+// The stage wrappers of the daemon. Each wraps the library's stage of its room; a room that the
+// library does not provide yet is a named seam (available() == false, ran == false in its
+// outputs): the runtime reports it and never invents a result.
+#include "stairguide/runtime/pipeline.hpp"
+
+#include <chrono>
+#include <cstdio>
+
+#include "stairguide/odometry/dense_odometry.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stairs.hpp"
+
+namespace stairguide::runtime {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Odometry: the odometry room's DenseOdometry, configured from the first frame's intrinsics (and
+// again whenever they change: a reconnected camera may come back in another mode).
+struct OdometryStage::Impl {
+  PipelineConfig config;
+  DenseOdometry odometry;
+  CameraIntrinsics intrinsics;
+  bool configured = false;
+};
+
+OdometryStage::OdometryStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->config = config;
+}
+OdometryStage::~OdometryStage() = default;
+
+OdometryOutput OdometryStage::step(const RgbdFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Impl& m = *impl_;
+  const CameraIntrinsics& k = frame.intrinsics;
+  if (!m.configured || k.width != m.intrinsics.width || k.height != m.intrinsics.height ||
+      k.fx != m.intrinsics.fx || k.fy != m.intrinsics.fy || k.cx != m.intrinsics.cx ||
+      k.cy != m.intrinsics.cy) {
+    const Pose keep = m.odometry.pose();
+    m.odometry.configure(m.config.odometry, k);
+    if (m.configured) m.odometry.reset(keep);  // a new camera mode continues the same track
+    m.intrinsics = k;
+    m.configured = true;
+  }
+  const OdometryResult r = m.odometry.track(frame);
+  OdometryOutput out;
+  out.seq = frame.index;
+  out.ran = true;
+  out.ok = r.ok;
+  out.status = r.ok ? "ok" : (r.why && *r.why ? r.why : to_string(r.status));
+  out.T_world_camera = r.T_world_camera;
+  out.ms = ms_since(t0);
+  return out;
+}
+void OdometryStage::reconfigure(const PipelineConfig& config) {
+  Impl& m = *impl_;
+  m.config = config;
+  if (m.configured) {
+    const Pose keep = m.odometry.pose();
+    m.odometry.configure(config.odometry, m.intrinsics);
+    m.odometry.reset(keep);
+  }
+}
+void OdometryStage::restart() { impl_->odometry.reset(impl_->odometry.pose()); }
+bool OdometryStage::available() const { return true; }
+std::string OdometryStage::describe() const { return "DenseOdometry"; }
+
+// ---------------------------------------------------------------------------------------------
+// Perception (segmentation, floor, Manhattan, classification) -> stairs (detection, modelling).
+// SEAM (traversal): the library has no traversal stage yet (paper 5.2: step counting with the
+// odometry pose); `T_world_camera` is handed in for it and unused until it lands.
+struct PerceptionStage::Impl {
+  explicit Impl(const PipelineConfig& c) : config(c), perception(c), stairs(c) {}
+  PipelineConfig config;
+  Perception perception;
+  StairStage stairs;
+  SceneResult scene;
+  StairResult stair;
+};
+
+PerceptionStage::PerceptionStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+PerceptionStage::~PerceptionStage() = default;
+
+PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const Pose* /*T_world_camera*/) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Impl& m = *impl_;
+  m.perception.process(frame, m.scene);
+  PerceptionOutput out;
+  out.seq = frame.index;
+  out.ran = true;
+  out.floor_found = m.scene.floor_found;
+  if (!m.scene.floor_found) {
+    out.state = "no_floor";
+    out.detail = m.scene.why.empty() ? "no floor" : m.scene.why;
+    m.stair = StairResult{};
+    m.stair.verdict = StairVerdict::kNoFloor;
+  } else {
+    m.stairs.run(m.scene, m.stair);
+    out.stair_detected = m.stair.detected;
+    if (m.stair.detected) {
+      out.state = to_string(m.stair.kind);
+      out.levels = m.stair.levels;
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
+                    to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m,
+                    m.stair.width_m, m.stair.origin().norm());
+      out.detail = buf;
+    } else {
+      out.state = "floor";
+      out.detail = std::string("floor, no stairs: ") + to_string(m.stair.verdict);
+    }
+  }
+  out.ms = ms_since(t0);
+  return out;
+}
+void PerceptionStage::reconfigure(const PipelineConfig& config) {
+  // The stages take their config at construction; tracking restarts with the new values.
+  impl_ = std::make_unique<Impl>(config);
+}
+bool PerceptionStage::available() const { return true; }
+std::string PerceptionStage::describe() const {
+  return "Perception+StairStage(traversal=none, seam: no traversal stage in the library)";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Feedback. SEAM: the feedback room (cue policy, audio, haptic) is not in this build; the decision
+// is the perceived state itself and no cue is played.
+struct FeedbackStage::Impl {
+  PipelineConfig config;
+  std::string last_state = "none";
+};
+
+FeedbackStage::FeedbackStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->config = config;
+}
+FeedbackStage::~FeedbackStage() = default;
+
+Decision FeedbackStage::decide(const PerceptionOutput& perception,
+                               const OdometryOutput* /*latest_odometry*/) {
+  Decision d;
+  d.state = perception.state;
+  d.changed = d.state != impl_->last_state;
+  impl_->last_state = d.state;
+  return d;
+}
+void FeedbackStage::camera_lost(const std::string& /*why*/) {}
+void FeedbackStage::camera_back() {}
+void FeedbackStage::reconfigure(const PipelineConfig& config) { impl_->config = config; }
+bool FeedbackStage::available() const { return false; }
+std::string FeedbackStage::describe() const { return "none(seam: feedback room not built)"; }
+
+std::string describe_stages(const PipelineConfig& config) {
+  return "odometry=" + OdometryStage(config).describe() +
+         " perception=" + PerceptionStage(config).describe() +
+         " feedback=" + FeedbackStage(config).describe();
+}
+
+}  // namespace stairguide::runtime

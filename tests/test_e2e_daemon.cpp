@@ -1,0 +1,446 @@
+// End to end: the stairguided binary replaying a synthetic .oni written into the build tree, with
+// NOTIFY_SOCKET on a test datagram socket (READY / WATCHDOG / STATUS), its per-frame lines,
+// SIGTERM, SIGHUP with a valid and an invalid config, a replay that ends, a corrupt recording, an
+// unreadable config; and the systemd unit (verify prints nothing, security rating <= 2.5).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stairguide/capture/oni.hpp"
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/config/config_loader.hpp"
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using namespace stairguide;
+
+namespace {
+
+const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_daemon_files";
+constexpr long kOniFrames = 150;  // 5 s at 30 Hz
+
+std::map<std::string, std::string> parse_kv(const std::string& line) {
+  std::istringstream is(line);
+  std::map<std::string, std::string> kv;
+  std::string tok;
+  while (is >> tok) {
+    const auto eq = tok.find('=');
+    if (eq != std::string::npos) kv[tok.substr(0, eq)] = tok.substr(eq + 1);
+  }
+  return kv;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream f(p);
+  f << text;
+}
+
+/// Runs a command, returns its exit code and combined stdout+stderr.
+int run_capture(const std::string& cmd, std::string& out) {
+  out.clear();
+  std::FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return -1;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/// stairguided as a child process: stdout through a pipe (the frame lines), stderr to a file,
+/// NOTIFY_SOCKET on an abstract datagram socket of this test.
+class Daemon {
+ public:
+  Daemon(const std::vector<std::string>& args, const std::string& name,
+         std::uint64_t watchdog_usec = 300000) {
+    static int counter = 0;
+    notify_name_ = "stairguide-test-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+    notify_fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::memcpy(addr.sun_path + 1, notify_name_.data(), notify_name_.size());  // abstract namespace
+    const socklen_t len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + notify_name_.size());
+    if (bind(notify_fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) ADD_FAILURE() << "bind notify socket";
+    stderr_path_ = kDir / (name + ".stderr");
+    int out_pipe[2];
+    if (pipe2(out_pipe, O_CLOEXEC) != 0) ADD_FAILURE() << "pipe";
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(out_pipe[1], 1);
+      const int err = open(stderr_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(err, 2);
+      setenv("NOTIFY_SOCKET", ("@" + notify_name_).c_str(), 1);
+      if (watchdog_usec) setenv("WATCHDOG_USEC", std::to_string(watchdog_usec).c_str(), 1);
+      unsetenv("WATCHDOG_PID");
+      unsetenv("JOURNAL_STREAM");
+      std::vector<char*> argv;
+      static std::string exe = STAIRGUIDED;
+      argv.push_back(exe.data());
+      std::vector<std::string> copy = args;
+      for (auto& a : copy) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+    close(out_pipe[1]);
+    out_fd_ = out_pipe[0];
+  }
+  ~Daemon() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      int st = 0;
+      waitpid(pid_, &st, 0);
+    }
+    if (out_fd_ >= 0) close(out_fd_);
+    if (notify_fd_ >= 0) close(notify_fd_);
+  }
+
+  /// Next stdout line, or false at EOF / timeout. Notifications arriving meanwhile are kept.
+  bool read_line(std::string& line, double timeout_s = 20.0) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+    for (;;) {
+      const auto nl = buf_.find('\n');
+      if (nl != std::string::npos) {
+        line = buf_.substr(0, nl);
+        buf_.erase(0, nl + 1);
+        return true;
+      }
+      if (eof_) return false;
+      const int ms =
+          static_cast<int>(std::chrono::duration<double, std::milli>(deadline - Clock::now()).count());
+      if (ms <= 0) return false;
+      pump(ms);
+    }
+  }
+
+  /// Waits until a notification containing `text` has arrived (or was already received).
+  bool wait_notify(const std::string& text, double timeout_s = 20.0) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+    for (;;) {
+      if (count_notify(text) > 0) return true;
+      const int ms =
+          static_cast<int>(std::chrono::duration<double, std::milli>(deadline - Clock::now()).count());
+      if (ms <= 0) return false;
+      pump(std::min(ms, 100));
+    }
+  }
+  int count_notify(const std::string& text) const {
+    int n = 0;
+    for (const auto& m : notes_)
+      if (m.find(text) != std::string::npos) ++n;
+    return n;
+  }
+  const std::vector<std::string>& notes() const { return notes_; }
+
+  void signal(int sig) { kill(pid_, sig); }
+
+  /// Reads everything left on stdout and waits for exit; returns the exit code (-1 on a signal or
+  /// timeout). `lines` gets the remaining stdout lines.
+  int wait_exit(double timeout_s, std::vector<std::string>* lines = nullptr) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+    for (;;) {
+      std::string l;
+      while (read_line(l, 0.0))
+        if (lines) lines->push_back(l);
+      int st = 0;
+      const pid_t r = waitpid(pid_, &st, WNOHANG);
+      if (r == pid_) {
+        exited_ = true;
+        std::string l2;
+        while (read_line(l2, 1.0))
+          if (lines) lines->push_back(l2);
+        pump(10);
+        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+      }
+      if (Clock::now() > deadline) return -1;
+      pump(10);
+    }
+  }
+
+  std::string stderr_text() const { return read_file(stderr_path_); }
+
+ private:
+  void pump(int ms) {
+    std::vector<pollfd> fds;
+    if (!eof_) fds.push_back({out_fd_, POLLIN, 0});
+    fds.push_back({notify_fd_, POLLIN, 0});
+    poll(fds.data(), fds.size(), std::max(ms, 0));
+    if (!eof_ && (fds[0].revents & (POLLIN | POLLHUP | POLLERR))) {
+      char b[4096];
+      const ssize_t k = ::read(out_fd_, b, sizeof b);
+      if (k > 0)
+        buf_.append(b, static_cast<std::size_t>(k));
+      else
+        eof_ = true;
+    }
+    for (;;) {
+      char b[4096];
+      const ssize_t k = recv(notify_fd_, b, sizeof b, MSG_DONTWAIT);
+      if (k <= 0) break;
+      notes_.emplace_back(b, static_cast<std::size_t>(k));
+    }
+  }
+
+  pid_t pid_ = -1;
+  int out_fd_ = -1, notify_fd_ = -1;
+  bool eof_ = false, exited_ = false;
+  std::string buf_, notify_name_;
+  fs::path stderr_path_;
+  std::vector<std::string> notes_;
+};
+
+class DaemonE2E : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    fs::create_directories(kDir);
+    oni_ = kDir / "climb.oni";
+    // The recording: a synthetic approach-and-climb at 320x240 (the daemon takes any size; the
+    // smaller one keeps this test quick), written as an .oni that OpenNI2's own player replays.
+    if (!fs::exists(oni_)) {
+      synth::SynthOptions so;
+      so.width = 320;
+      so.height = 240;
+      auto src = synth::make_source("ascending_approach_climb", kOniFrames, 7, so);
+      // ctest runs each test case as its own process, maybe two at once: write under a unique
+      // name, then rename (atomic; both writers produce the same file).
+      const fs::path tmp = kDir / ("climb.oni.part" + std::to_string(getpid()));
+      {
+        OniWriter w(tmp.string(), src->intrinsics(), true, 30);
+        RgbdFrame f;
+        for (long i = 0; i < kOniFrames; ++i) {
+          ASSERT_TRUE(src->read(f).ok());
+          w.write(f);
+        }
+        w.close();
+      }
+      fs::rename(tmp, oni_);
+    }
+    // The config: shipped defaults with counters every 0.3 s.
+    PipelineConfig c;
+    c.runtime.status_interval = 0.3f;
+    config_ = kDir / "daemon.yaml";
+    const fs::path tmp_cfg = kDir / ("daemon.yaml.part" + std::to_string(getpid()));
+    write_file(tmp_cfg, dump_config_yaml(c));
+    fs::rename(tmp_cfg, config_);
+  }
+  static fs::path oni_, config_;
+};
+fs::path DaemonE2E::oni_, DaemonE2E::config_;
+
+}  // namespace
+
+TEST_F(DaemonE2E, ReplayNotifiesReadyWatchdogStatusPrintsFramesAndStopsOnSigterm) {
+  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--realtime"}, "sigterm");
+  ASSERT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
+  std::vector<std::string> lines;
+  std::string l;
+  while (lines.size() < 45 && d.read_line(l, 20)) lines.push_back(l);  // 1.5 s of frames
+  ASSERT_TRUE(d.wait_notify("WATCHDOG=1", 5));
+  ASSERT_TRUE(d.wait_notify("STATUS=running: capture", 5)) << "counters in STATUS";
+  for (const auto& m : d.notes())
+    if (m.rfind("STATUS=running: capture", 0) == 0) {
+      for (const char* key : {"odometry", "perception", "fps", "skipped", "lost", "latency p50", "p99"})
+        EXPECT_NE(m.find(key), std::string::npos) << key << " missing from " << m;
+      break;
+    }
+  const auto t0 = Clock::now();
+  d.signal(SIGTERM);
+  const int code = d.wait_exit(5.0, &lines);
+  const double stop_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(code, 0) << d.stderr_text();
+  EXPECT_LT(stop_s, 1.0) << "SIGTERM must stop the daemon within 1 s";
+  EXPECT_GE(d.count_notify("STOPPING=1"), 1);
+
+  // Frame lines: consecutive from 0, every one through odometry; skips counted in the summary.
+  ASSERT_FALSE(lines.empty());
+  ASSERT_EQ(lines.back().rfind("summary ", 0), 0u) << lines.back();
+  const auto summary = parse_kv(lines.back());
+  lines.pop_back();
+  ASSERT_GE(lines.size(), 45u);
+  long skipped = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const auto kv = parse_kv(lines[i]);
+    ASSERT_EQ(kv.at("frame"), std::to_string(i)) << lines[i];
+    EXPECT_TRUE(kv.at("odom") == "ok" || kv.at("odom").rfind("fail:", 0) == 0) << lines[i];
+    skipped += kv.at("perception") == "skipped";
+  }
+  EXPECT_EQ(summary.at("state"), "stopped");
+  EXPECT_EQ(std::stol(summary.at("odometry_lost")), 0);
+  EXPECT_EQ(std::stol(summary.at("odometry_frames")), std::stol(summary.at("frames")));
+  // Frames captured but not yet printed when SIGTERM came are not in the lines; the printed ones
+  // account for their skips exactly.
+  EXPECT_LE(skipped, std::stol(summary.at("perception_skipped")));
+  EXPECT_GE(std::stol(summary.at("frames")), static_cast<long>(lines.size()));
+}
+
+TEST_F(DaemonE2E, ReplayThatEndsExitsZeroWithEveryFrameThroughOdometry) {
+  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--fast"}, "ends");
+  std::vector<std::string> lines;
+  const int code = d.wait_exit(120.0, &lines);
+  ASSERT_EQ(code, 0) << d.stderr_text();
+  ASSERT_EQ(lines.size(), static_cast<std::size_t>(kOniFrames + 1));
+  const auto summary = parse_kv(lines.back());
+  EXPECT_EQ(summary.at("state"), "ended");
+  EXPECT_EQ(std::stol(summary.at("odometry_frames")), kOniFrames);
+  EXPECT_EQ(std::stol(summary.at("odometry_lost")), 0);
+  long skipped = 0, perceived = 0, stairs = 0;
+  for (long i = 0; i < kOniFrames; ++i) {
+    const auto kv = parse_kv(lines[static_cast<std::size_t>(i)]);
+    EXPECT_EQ(kv.at("frame"), std::to_string(i));
+    EXPECT_NE(kv.at("odom"), "none");
+    if (kv.at("perception") == "skipped")
+      ++skipped;
+    else
+      ++perceived;
+    stairs += kv.at("perception") == "ascending";
+  }
+  EXPECT_EQ(skipped, std::stol(summary.at("perception_skipped"))) << "every skipped frame is reported";
+  EXPECT_EQ(perceived, std::stol(summary.at("perception_frames")));
+  EXPECT_GT(stairs, 0) << "the climb's staircase is seen at least once";
+  EXPECT_TRUE(d.wait_notify("READY=1", 1));
+}
+
+TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {
+  const fs::path cfg = kDir / "reload.yaml";
+  fs::copy_file(config_, cfg, fs::copy_options::overwrite_existing);
+  Daemon d({"--config", cfg.string(), "--replay", oni_.string(), "--realtime"}, "sighup");
+  ASSERT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
+  std::string l;
+  ASSERT_TRUE(d.read_line(l));
+  EXPECT_EQ(parse_kv(l).at("cfg"), "1");
+
+  // A valid change: applied without restart (the frame lines show config generation 2).
+  PipelineConfig c = load_config(cfg.string());
+  c.segmentation.voxel_size = 0.05f;
+  write_file(cfg, dump_config_yaml(c));
+  d.signal(SIGHUP);
+  bool applied = false;
+  for (int i = 0; i < 60 && !applied && d.read_line(l, 10); ++i) applied = parse_kv(l).at("cfg") == "2";
+  ASSERT_TRUE(applied) << d.stderr_text();
+
+  // An invalid file: logged error naming the file and key, old config kept, still running.
+  write_file(cfg, "segmentation:\n  voxel_size_cm: banana\n");
+  d.signal(SIGHUP);
+  const auto until = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < until && d.stderr_text().find("reload rejected") == std::string::npos)
+    d.read_line(l, 0.1);
+  const std::string err = d.stderr_text();
+  EXPECT_NE(err.find("config reload rejected"), std::string::npos) << err;
+  EXPECT_NE(err.find("reload.yaml"), std::string::npos) << "the message names the file";
+  EXPECT_NE(err.find("voxel_size_cm"), std::string::npos) << "the message names the key";
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(d.read_line(l, 5)) << "the daemon kept running";
+    EXPECT_EQ(parse_kv(l).at("cfg"), "2");
+  }
+  d.signal(SIGTERM);
+  EXPECT_EQ(d.wait_exit(5.0), 0);
+}
+
+TEST_F(DaemonE2E, CorruptOrMissingRecordingFailsWithAClearMessage) {
+  const fs::path bad = kDir / "corrupt.oni";
+  write_file(bad, std::string(4096, '\x5a'));
+  {
+    Daemon d({"--config", config_.string(), "--replay", bad.string()}, "corrupt");
+    EXPECT_EQ(d.wait_exit(30.0), 4);
+    EXPECT_NE(d.stderr_text().find("corrupt.oni"), std::string::npos) << d.stderr_text();
+    EXPECT_EQ(d.count_notify("READY=1"), 0);
+  }
+  {
+    Daemon d({"--config", config_.string(), "--replay", (kDir / "missing.oni").string()}, "missing");
+    EXPECT_EQ(d.wait_exit(30.0), 4);
+    EXPECT_NE(d.stderr_text().find("missing.oni"), std::string::npos) << d.stderr_text();
+  }
+}
+
+TEST_F(DaemonE2E, UnreadableOrInvalidConfigIsNamedAndNothingRuns) {
+  {
+    Daemon d({"--config", (kDir / "nope.yaml").string(), "--replay", oni_.string()}, "noconfig");
+    EXPECT_EQ(d.wait_exit(10.0), 3);
+    EXPECT_NE(d.stderr_text().find("nope.yaml"), std::string::npos) << d.stderr_text();
+  }
+  const fs::path bad = kDir / "bad.yaml";
+  write_file(bad, "runtime:\n  ring_capacity: 1\n");
+  {
+    Daemon d({"--config", bad.string(), "--replay", oni_.string()}, "badconfig");
+    std::vector<std::string> lines;
+    EXPECT_EQ(d.wait_exit(10.0, &lines), 3);
+    EXPECT_TRUE(lines.empty()) << "no frame may run on a rejected config";
+    EXPECT_NE(d.stderr_text().find("ring_capacity"), std::string::npos) << d.stderr_text();
+  }
+  std::string out;
+  EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --check-config " + config_.string(), out), 0) << out;
+  EXPECT_NE(run_capture(std::string(STAIRGUIDED) + " --check-config " + bad.string(), out), 0);
+  EXPECT_NE(out.find("ring_capacity"), std::string::npos) << out;
+  EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --bogus", out), 2);
+}
+
+// The unit as installed points at the installed binary; verify it with the built one in its place.
+TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost2_5) {
+  std::string out;
+  if (run_capture("command -v systemd-analyze", out) != 0) GTEST_SKIP() << "systemd-analyze not installed";
+  fs::create_directories(kDir);
+  const std::string unit = read_file(fs::path(STAIRGUIDE_SOURCE_DIR) / "systemd" / "stairguide.service");
+  ASSERT_NE(unit.find("ExecStart=/usr/bin/stairguided "), std::string::npos);
+  const fs::path test_unit = kDir / "stairguide.service";
+  write_file(test_unit,
+             std::regex_replace(unit, std::regex("/usr/bin/stairguided"), std::string(STAIRGUIDED)));
+
+  const int rc = run_capture("systemd-analyze verify " + test_unit.string(), out);
+  EXPECT_EQ(rc, 0);
+  EXPECT_EQ(out, "") << "systemd-analyze verify must print nothing";
+
+  run_capture("systemd-analyze security --offline=true --no-pager " + test_unit.string(), out);
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(out, m, std::regex("Overall exposure level for stairguide.service: ([0-9.]+)")))
+      << out;
+  EXPECT_LE(std::stod(m[1]), 2.5) << out;
+
+  // What the daemon relies on is in the unit.
+  for (const char* key : {"Type=notify", "WatchdogSec=", "User=stairguide", "ExecReload=",
+                          "DevicePolicy=closed", "DeviceAllow=char-usb_device rw", "DeviceAllow=char-alsa rw",
+                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio"})
+    EXPECT_NE(unit.find(key), std::string::npos) << key;
+}
+
+TEST(SystemdUnit, SysusersCreatesTheUserAndGpioGroup) {
+  std::string out;
+  if (run_capture("command -v systemd-sysusers", out) != 0) GTEST_SKIP() << "systemd-sysusers not installed";
+  const fs::path root = kDir / "sysroot";
+  fs::remove_all(root);
+  fs::create_directories(root / "etc");
+  const fs::path conf = fs::path(STAIRGUIDE_SOURCE_DIR) / "systemd" / "stairguide.sysusers";
+  ASSERT_EQ(run_capture("systemd-sysusers --root=" + root.string() + " " + conf.string(), out), 0) << out;
+  const std::string passwd = read_file(root / "etc" / "passwd"), group = read_file(root / "etc" / "group");
+  EXPECT_NE(passwd.find("stairguide:x:"), std::string::npos) << passwd;
+  EXPECT_NE(passwd.find("nologin"), std::string::npos) << passwd;
+  EXPECT_TRUE(std::regex_search(group, std::regex("(^|\n)gpio:x:[0-9]+:stairguide"))) << group;
+  const std::string rules =
+      read_file(fs::path(STAIRGUIDE_SOURCE_DIR) / "systemd" / "60-stairguide-gpio.rules");
+  EXPECT_NE(rules.find("SUBSYSTEM==\"gpio\""), std::string::npos);
+  EXPECT_NE(rules.find("GROUP=\"gpio\""), std::string::npos);
+}
