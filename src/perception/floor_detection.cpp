@@ -30,10 +30,140 @@ void tilt_roll_from_up(const Eigen::Vector3f& up, float& tilt, float& roll) {
 
 FloorDetector::FloorDetector(const FloorConfig& config) : cfg_(config) {}
 
+namespace {
+// Horizontal distance from the camera's foot (the camera projected on the plane along `up`).
+float foot_distance(const Eigen::Vector3f& up, const Eigen::Vector3f& q) {
+  const float np = up.dot(q);
+  return std::sqrt(std::max(0.f, q.squaredNorm() - np * np));
+}
+// Tangent of the angle between the ray to q and the nadir (-up): how near the user's feet the
+// camera sees q, independent of how high q is. Points level with or above the camera: +inf.
+float nadir_tan(const Eigen::Vector3f& up, const Eigen::Vector3f& q) {
+  const float below = -up.dot(q);
+  if (below <= 1e-3f) return 1e9f;
+  return foot_distance(up, q) / below;
+}
+float percentile(std::vector<float>& v, std::size_t per_mille) {
+  if (v.empty()) return 1e9f;
+  const std::size_t k = v.size() * per_mille / 1000;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+}  // namespace
+
+FloorDetector::Reach FloorDetector::reach(const PlaneRegion& r) {
+  // 2nd percentiles: robust to stray points.
+  Reach out;
+  // Every other point of the (already subsampled) region is plenty for a 2nd percentile.
+  const std::size_t step = r.points.size() > 400 ? 2 : 1;
+  near_buf_.clear();
+  for (std::size_t k = 0; k < r.points.size(); k += step) near_buf_.push_back(foot_distance(r.normal, r.points[k]));
+  out.distance = percentile(near_buf_, 20);
+  near_buf_.clear();
+  for (std::size_t k = 0; k < r.points.size(); k += step) near_buf_.push_back(nadir_tan(r.normal, r.points[k]));
+  out.angle = std::atan(percentile(near_buf_, 20));
+  return out;
+}
+
+void FloorDetector::sample_frame(const RgbdFrame& frame) {
+  // A sparse grid of the frame's points, enough to see a riser or a seat's front (hundreds of
+  // pixels) at a few microseconds per candidate test.
+  samples_.clear();
+  const cv::Mat& D = frame.depth;
+  if (D.empty() || D.type() != CV_32FC1) return;
+  const CameraIntrinsics& K = frame.intrinsics;
+  const int s = std::max(1, cfg_.verify_stride_px);
+  sample_weight_ = static_cast<float>(s * s);
+  for (int v = s / 2; v < D.rows; v += s) {
+    const float* row = D.ptr<float>(v);
+    const float vn = (static_cast<float>(v) - K.cy) / K.fy;
+    for (int u = s / 2; u < D.cols; u += s) {
+      const float z = row[u];
+      if (!(z > 0.f) || !std::isfinite(z)) continue;
+      samples_.emplace_back((static_cast<float>(u) - K.cx) / K.fx * z, vn * z, z);
+    }
+  }
+}
+
+bool FloorDetector::nothing_below(const PlaneRegion& r, const Reach& near) const {
+  // The user stands on the floor: nothing the camera sees nearer the user's feet (nearer the
+  // nadir) than the floor itself can lie clearly below it. A tread, a platform, a seat or a bed
+  // seen from in front has its front face (a riser, the seat's front) or the real floor under its
+  // near edge, seen between it and the user's feet; the floor the user stands on only has drops
+  // (a descending staircase, a curb down) beyond its own near edge. Compared by the angle from
+  // the nadir, not by metres: a riser lies right under its tread's edge, nearer the nadir only
+  // because it is lower.
+  const float t = std::tan(std::max(0.f, near.angle - cfg_.verify_margin_angle));
+  float below = 0.f;
+  for (const auto& q : samples_) {
+    const float h = r.normal.dot(q) + r.offset;  // height above the candidate plane
+    if (h > -cfg_.verify_drop) continue;
+    if (nadir_tan(r.normal, q) >= t) continue;
+    below += sample_weight_;
+  }
+  return below < static_cast<float>(cfg_.verify_min_pixels);
+}
+
+bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width) {
+  // A plane that starts at the bottom of the view (we cannot see what the user stands on) with
+  // another plane one riser above or below it starting a tread's depth further: the first tread
+  // of an ascending staircase filling the bottom of the view looks exactly like a floor with a
+  // staircase right ahead, and a tread of a descending staircase the user is on like the floor at
+  // its top. When the floor cannot be told from a tread, no floor is reported.
+  const PlaneRegion& C = regions[c];
+  // Nadir tangent of the view's border nearest the feet, for this plane: the nadir is below the
+  // view (tilt <= 70 deg), so the minimum over the view lies on its border; sampled every 8 px.
+  float lowest = 1e9f;
+  const CameraIntrinsics& K = K_;
+  auto ray = [&](float u, float v) {
+    lowest = std::min(lowest, nadir_tan(C.normal, Eigen::Vector3f((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f)));
+  };
+  const float Wf = static_cast<float>(K.width - 1), Hf = static_cast<float>(K.height - 1);
+  for (float u = 0.f; u <= Wf; u += 8.f) ray(u, 0.f), ray(u, Hf);
+  for (float v = 0.f; v <= Hf; v += 8.f) ray(0.f, v), ray(Wf, v);
+  const float edge = std::atan(lowest) + cfg_.view_edge_angle;
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
+  if (near.angle > edge) return false;  // its near edge is seen
+  for (std::size_t j = 0; j < regions.size(); ++j) {
+    if (static_cast<int>(j) == c) continue;
+    const PlaneRegion& A = regions[j];
+    if (A.area < 0.1f * cfg_.min_area || A.normal.dot(C.normal) < cos_par) continue;
+    // One riser above (an ascending staircase from here) or below (a descending one: the user may
+    // stand on a tread higher up, out of view, with this one its next but one).
+    const float rise = std::fabs(C.offset - A.offset);
+    if (rise < cfg_.ambiguous_rise_min || rise > cfg_.ambiguous_rise_max) continue;
+    float a_near = 1e9f;
+    for (const auto& q : A.points) a_near = std::min(a_near, foot_distance(C.normal, q));
+    if (a_near - near.distance > cfg_.ambiguous_depth_max) continue;
+    // A tread fills the view's width only as far as the staircase does: the floor usually shows
+    // beside a step (columns of the image where it runs on with nothing above it). Ambiguous
+    // only when nearly all of the candidate lies in image columns where the upper plane lies
+    // above it.
+    if (C.pixels.empty() || A.pixels.empty() || width <= 0) return true;
+    col_top_.assign(static_cast<std::size_t>(width), -1);
+    for (int p : A.pixels) {
+      const int u = p % width, v = p / width;
+      col_top_[static_cast<std::size_t>(u)] = std::max(col_top_[static_cast<std::size_t>(u)], v);  // A's lowest row
+    }
+    std::size_t under = 0, seen = 0;
+    for (std::size_t k = 0; k < C.pixels.size(); k += 4, ++seen) {  // a subsample is enough for a share
+      const int p = C.pixels[k];
+      const int u = p % width, v = p / width;
+      const int a_row = col_top_[static_cast<std::size_t>(u)];
+      if (a_row >= 0 && a_row < v) ++under;
+    }
+    if (static_cast<float>(under) >= cfg_.ambiguous_covered * static_cast<float>(seen)) return true;
+  }
+  return false;
+}
+
 FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame) {
   FloorEstimate est;
   const int n = static_cast<int>(regions.size());
   const float area_k = 1.f / (frame.intrinsics.fx * frame.intrinsics.fy);
+  sample_frame(frame);
+  K_ = frame.intrinsics;
+  if (K_.width <= 0 || K_.height <= 0) K_.width = frame.depth.cols, K_.height = frame.depth.rows;
 
   // Rule checks on orientation and distance.
   std::vector<int> cand;
@@ -49,9 +179,86 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
   }
   if (cand.empty()) {
     est.why = "no plane with a chest camera's orientation and height";
-    return est;
+    return lost(est);
+  }
+  // Hold: while the tracked floor was seen a moment ago, a plane a riser above or below it is a
+  // step, never the new floor (the user cannot have changed level without passing through
+  // frames where the old floor was still in view for long).
+  if (prev_ && lost_frames_ < cfg_.track_hold_frames) {
+    const float cos_jump = std::cos(cfg_.track_max_angle_jump);
+    cand.erase(std::remove_if(cand.begin(), cand.end(),
+                              [&](int i) {
+                                return regions[i].normal.dot(prev_->normal) < cos_jump ||
+                                       std::fabs(regions[i].offset - prev_->offset) > cfg_.track_max_height_jump;
+                              }),
+               cand.end());
+    if (cand.empty()) {
+      est.why = "the tracked floor is out of view and the planes in view are at another level (steps)";
+      return lost(est);
+    }
   }
 
+  // Choose, verify, and on failure drop every candidate on the rejected plane and choose again:
+  // a missed floor is recovered by tracking, a wrong one hides a staircase.
+  int chosen = -1;
+  int rejected_below = 0, rejected_stair = 0;
+  while (!cand.empty()) {
+    bool tracked = false;
+    chosen = choose(regions, cand, area_k, tracked);
+    if (chosen < 0) break;
+    const PlaneRegion& f = regions[chosen];
+    const Reach near = reach(f);
+    const bool clear = nothing_below(f, near);
+    // The tracked floor has been told from the steps already: no ambiguity left.
+    const bool stair = clear && !tracked && stair_from_view_edge(regions, chosen, near, frame.depth.cols);
+    if (clear && !stair) {
+      est.tracked = tracked;
+      break;
+    }
+    if (!clear) ++rejected_below;
+    else ++rejected_stair;
+    const Eigen::Vector3f n0 = f.normal;
+    const float d0 = f.offset;
+    cand.erase(std::remove_if(cand.begin(), cand.end(),
+                              [&](int i) {
+                                return regions[i].normal.dot(n0) >= std::cos(cfg_.horizontal_tolerance) &&
+                                       std::fabs(regions[i].offset - d0) < cfg_.inlier_distance;
+                              }),
+               cand.end());
+    chosen = -1;
+  }
+  if (chosen < 0) {
+    if (rejected_below + rejected_stair == 0)
+      est.why = "no floor-like plane with enough area within the search window";
+    else if (rejected_stair == 0)
+      est.why = "every floor-like plane has something below it nearer the user (a step, a seat)";
+    else if (rejected_below == 0)
+      est.why = "the floor-like plane may be a tread: a step rises right after where the view starts";
+    else
+      est.why = "the floor-like planes have something below them nearer the user, or may be a tread";
+    return lost(est);
+  }
+  const PlaneRegion& f = regions[chosen];
+  est.found = true;
+  est.region = chosen;
+  est.normal = f.normal;
+  est.offset = f.offset;
+  est.height = f.offset;
+  tilt_roll_from_up(f.normal, est.tilt, est.roll);
+  est.T_floor_camera = floor_pose_from_plane(f.normal, f.offset);
+  prev_ = Prev{f.normal, f.offset};
+  lost_frames_ = 0;
+  return est;
+}
+
+FloorEstimate& FloorDetector::lost(FloorEstimate& est) {
+  if (prev_ && ++lost_frames_ >= cfg_.track_hold_frames) prev_.reset();
+  return est;
+}
+
+int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k,
+                          bool& tracked) {
+  tracked = false;
   // Tracking: the previous floor, when it is still in view, stays the floor.
   int chosen = -1;
   if (prev_) {
@@ -66,9 +273,11 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
       }
     }
     if (chosen >= 0 && regions[chosen].area < 0.25f * cfg_.min_area) chosen = -1;
-    if (chosen >= 0) est.tracked = true;
+    if (chosen >= 0) {
+      tracked = true;
+      return chosen;
+    }
   }
-
   if (chosen < 0) {
     // Search window on z_C growing from search_start: the floor is what the user stands on, so
     // it is the plane nearest the camera's feet, not the biggest one. One pass per candidate
@@ -110,52 +319,30 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
       }
     }
   }
-  if (chosen >= 0 && !est.tracked) {
+  if (chosen >= 0) {
     // The user stands on the floor: of two parallel candidates a riser or more apart, the floor
-    // is the one that reaches nearer the camera's foot (a first step or a landing right ahead
-    // can be nearer the camera and bigger in the window, but it starts further ahead).
-    auto near_distance = [](const PlaneRegion& r) {
-      std::vector<float> h;
-      h.reserve(r.points.size());
-      for (const auto& q : r.points) {
-        const float np = r.normal.dot(q);
-        h.push_back(std::sqrt(std::max(0.f, q.squaredNorm() - np * np)));
-      }
-      if (h.empty()) return 1e9f;
-      const std::size_t k = h.size() / 50;  // 2nd percentile: robust to stray points
-      std::nth_element(h.begin(), h.begin() + static_cast<long>(k), h.end());
-      return h[k];
-    };
-    float best_near = near_distance(regions[chosen]);
+    // is the lower one when it reaches as near the user's feet in the view (a seat, a first step
+    // or a landing right ahead is nearer the camera and can be bigger in the window). Nearness
+    // is the angle from the nadir: in metres a higher plane seen at the bottom of the view is
+    // always nearer than the lower floor seen beside it.
     const float cos_par = std::cos(cfg_.horizontal_tolerance);
     const int first = chosen;
+    float best = reach(regions[first]).angle;
     for (int i : cand) {
       if (i == first) continue;
       const PlaneRegion& r = regions[i];
-      // Even a small patch of a lower plane at the user's feet outranks a bigger step ahead.
-      if (r.area < 0.1f * cfg_.min_area || r.normal.dot(regions[first].normal) < cos_par) continue;
-      if (std::fabs(r.offset - regions[first].offset) < cfg_.inlier_distance) continue;
-      const float nd = near_distance(r);
-      if (nd + 0.05f < best_near) {
-        best_near = nd;
+      // A patch of a lower plane at the user's feet outranks a bigger step ahead (but not a sliver).
+      if (r.area < 0.25f * cfg_.min_area || r.normal.dot(regions[first].normal) < cos_par) continue;
+      if (r.offset - regions[chosen].offset < cfg_.inlier_distance) continue;  // only lower planes
+      const float a = reach(r).angle;
+      if (a <= best + cfg_.view_edge_angle) {
+        best = std::min(best, a);
         chosen = i;
       }
     }
   }
-  if (chosen < 0) {
-    est.why = "no floor-like plane with enough area within the search window";
-    return est;
-  }
-  const PlaneRegion& f = regions[chosen];
-  est.found = true;
-  est.region = chosen;
-  est.normal = f.normal;
-  est.offset = f.offset;
-  est.height = f.offset;
-  tilt_roll_from_up(f.normal, est.tilt, est.roll);
-  est.T_floor_camera = floor_pose_from_plane(f.normal, f.offset);
-  prev_ = Prev{f.normal, f.offset};
-  return est;
+  return chosen;
 }
 
 }  // namespace stairguide
+

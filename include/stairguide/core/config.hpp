@@ -114,6 +114,16 @@ struct FloorConfig {
   float track_max_height_jump = 0.08f;  ///< m, change of camera height accepted between frames
   float track_max_angle_jump = 0.17453293f;  ///< rad, change of floor normal accepted between frames
   float horizontal_tolerance = 0.17453293f;  ///< rad, floor candidates vs the tracked floor normal (10 deg)
+  int track_hold_frames = 15;     ///< frames the tracked floor is held after it was last seen
+  float verify_drop = 0.06f;      ///< m, a point this far below a floor candidate counts as "below"
+  float verify_margin_angle = 0.0087266f;  ///< rad, "nearer the user": this much nearer the nadir than the candidate's near edge (0.5 deg)
+  float view_edge_angle = 0.034906585f;    ///< rad, a plane within this of the view's bottom edge "starts at the edge" (2 deg)
+  float ambiguous_rise_min = 0.10f;  ///< m, a plane this much above a candidate starting at the view's edge ...
+  float ambiguous_rise_max = 0.22f;  ///< m, ... and at most this ...
+  float ambiguous_depth_max = 0.45f; ///< m, ... and starting within this of its near edge: the candidate may be a tread
+  float ambiguous_covered = 0.9f;    ///< share of such a candidate's pixels with the upper plane above them in the image
+  int verify_min_pixels = 400;    ///< px, this many pixels below and nearer reject a floor candidate
+  int verify_stride_px = 6;       ///< px, sampling grid of the frame for the check
 
   template <class V> void visit(V& v) {
     v.num(tilt_min, "tilt_min_deg", Unit::kDegree, 0, 90, "camera pitch below horizontal: lowest");
@@ -132,6 +142,24 @@ struct FloorConfig {
           "floor normal change accepted from one frame to the next");
     v.num(horizontal_tolerance, "horizontal_tolerance_deg", Unit::kDegree, 0.5, 45,
           "a plane parallel to the floor within this is a second floor candidate (never taken when nearer the camera)");
+    v.num(track_hold_frames, "track_hold_frames", Unit::kCount, 0, 1000,
+          "frames the tracked floor is held after it was last seen (no other level taken meanwhile)");
+    v.num(verify_drop, "verify_drop_cm", Unit::kCentimetre, 1, 100,
+          "floor check: a point this far below a candidate counts as below it");
+    v.num(verify_margin_angle, "verify_margin_deg", Unit::kDegree, 0, 30,
+          "floor check: points this much nearer the nadir than the candidate's near edge count as nearer the user");
+    v.num(view_edge_angle, "view_edge_deg", Unit::kDegree, 0, 30,
+          "a plane within this of the view's bottom edge starts at the edge (its start is not seen)");
+    v.num(ambiguous_rise_min, "ambiguous_rise_min_cm", Unit::kCentimetre, 1, 100,
+          "a candidate starting at the view's edge with a plane this much (min) above it ...");
+    v.num(ambiguous_rise_max, "ambiguous_rise_max_cm", Unit::kCentimetre, 1, 100, "... and at most this ...");
+    v.num(ambiguous_depth_max, "ambiguous_depth_max_cm", Unit::kCentimetre, 1, 500,
+          "... starting within this of its near edge may be a tread: not taken as the floor");
+    v.num(ambiguous_covered, "ambiguous_covered_percent", Unit::kPercent, 0, 100,
+          "... when this share of its pixels has the upper plane above them in the image");
+    v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,
+          "floor check: this many pixels below a candidate and nearer the user reject it (a step or seat seen from in front)");
+    v.num(verify_stride_px, "verify_stride_px", Unit::kPixel, 1, 32, "floor check: sampling grid of the frame");
   }
 };
 
@@ -213,6 +241,7 @@ struct StairModellingConfig {
   float manhattan_max_disagreement = 0.08726646f;  ///< rad, Manhattan axes used only within this of the steps' own axes (5 deg)
   float dimension_tolerance = 0.01f;    ///< m, measurement slack on the building-code limits
   float edge_max_residual = 0.06f;      ///< m, largest deviation of a step edge from even spacing
+  float tread_tolerance_per_m2 = 0.004f;  ///< m per m^2 of distance: extra slack on tread and 2R+T far away
 
   template <class V> void visit(V& v) {
     v.num(riser_min, "riser_min_cm", Unit::kCentimetre, 1, 100, "building code: lowest riser");
@@ -229,6 +258,8 @@ struct StairModellingConfig {
           "measurement slack on the building-code limits");
     v.num(edge_max_residual, "edge_max_residual_cm", Unit::kCentimetre, 0.5, 50,
           "largest deviation of a step edge from evenly spaced edges");
+    v.num(tread_tolerance_per_m2, "tread_tolerance_cm_per_m2", Unit::kCentimetre, 0, 10,
+          "extra slack on the tread and 2R+T limits per square metre of distance to the first edge");
   }
 };
 

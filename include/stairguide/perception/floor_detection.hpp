@@ -11,6 +11,18 @@
 /// track_max_angle_jump of it is preferred, so that the first step (nearer than the floor when the
 /// user stands in front of it) never replaces the floor. Candidates parallel to the floor and
 /// higher (nearer the camera) are never taken while the tracked floor is still in view.
+/// Hold: for track_hold_frames frames after the tracked floor was last seen, only planes within
+/// the tracking tolerances of it can be the floor (a step is never taken for it meanwhile).
+/// Verification (safety): the chosen plane is rejected when more than verify_min_pixels of the
+/// frame lie verify_drop or more below it, nearer the user's feet than the plane's own near edge
+/// (+ verify_margin): then it is a tread, a platform or a seat seen from in front (its front face
+/// or the real floor lies below its near edge), not what the user stands on. Every candidate on
+/// a rejected plane is dropped and the choice made again; when nothing is left the frame has no
+/// floor ("no floor" is recoverable, a wrong floor hides a staircase). A plane whose near edge is
+/// the bottom of the view, with another plane one riser above it a tread's depth further, may be
+/// the first tread of a staircase filling the view: it is not taken either.
+/// Of parallel candidates, a lower one reaching as near the user's feet (angle from the nadir)
+/// wins over a higher one (a seat or a platform beside the floor).
 
 #include <optional>
 #include <string>
@@ -50,11 +62,31 @@ class FloorDetector {
   /// Chooses the floor among `regions` (from Segmentation on `frame`).
   FloorEstimate detect(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame);
   /// Forgets the tracked floor (a new sequence).
-  void reset() { prev_.reset(); }
+  void reset() {
+    prev_.reset();
+    lost_frames_ = 0;
+  }
   const FloorConfig& config() const { return cfg_; }
 
  private:
+  int choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k, bool& tracked);
+  struct Reach {
+    float distance = 1e9f;  // m from the camera's foot to the plane's near edge
+    float angle = 1.6f;     // rad from the nadir to the plane's near edge
+  };
+  Reach reach(const PlaneRegion& r);
+  FloorEstimate& lost(FloorEstimate& est);
+  int lost_frames_ = 0;
+  void sample_frame(const RgbdFrame& frame);
+  bool nothing_below(const PlaneRegion& r, const Reach& near) const;
+  bool stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width);
+  std::vector<int> col_top_;
+  CameraIntrinsics K_;
+
   FloorConfig cfg_;
+  std::vector<Eigen::Vector3f> samples_;  // sparse grid of the frame's points, camera frame
+  float sample_weight_ = 1.f;             // pixels per sample
+  std::vector<float> near_buf_;
   struct Prev {
     Eigen::Vector3f normal;
     float offset;
