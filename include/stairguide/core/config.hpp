@@ -222,11 +222,11 @@ struct StairDetectionConfig {
     v.num(curb_height_min, "curb_height_min_cm", Unit::kCentimetre, 1, 100,
           "lowest curb: a single level this far above or below the floor may be a curb");
     v.num(single_min_width, "single_min_width_m", Unit::kMetre, 0.05, 10,
-          "a single level narrower than this is an obstacle, not a step (half of it when cut by the image border)");
+          "a single level narrower than this is an obstacle, not a step");
     v.num(single_min_depth, "single_min_depth_m", Unit::kMetre, 0.05, 10,
           "a single level shallower than this is an obstacle, not a step");
     v.num(curb_min_depth, "curb_min_depth_m", Unit::kMetre, 0.1, 100,
-          "a single raised level deeper than this, or running out of view on both sides, is another floor level (a curb)");
+          "a single raised level deeper than this, or running out of view on both sides and the far side, is another floor level (a curb)");
   }
 };
 

@@ -1,0 +1,100 @@
+#pragma once
+/// \file stair_eval.hpp
+/// Scoring of stair results against ground truth (FrameTruth from the synthetic world or a
+/// labelled dataset): the figures `stairguide eval` prints and the tests assert.
+///
+/// Per frame:
+///  - a truth stair is *expected* when it has at least two visible treads (one for a single step or
+///    curb): those frames make the recall;
+///  - a detection *matches* a truth stair when it goes the same way (up: ascending, single step,
+///    curb up; down: descending, curb down) and its first edge lies within `match_distance` of the
+///    true first edge (perpendicular distance to the true edge line);
+///  - TP: an expected stair detected and matched; FN: an expected stair not matched; FP: a
+///    detection that matches no visible truth stair; TN: no visible stair, nothing detected. A
+///    frame whose only stair is visible but not expected (one tread in view) and is not detected
+///    counts in none of them (`skipped`); if it is detected and matched it is a TP. Recall is also
+///    given over the *fully visible* stairs: expected, with the first edge and both its ends in view.
+///  - frames where the user stands on a step (StairTruth::user_step > 0) are skipped: the first
+///    edge is behind the user and the steps are the traversal's business (paper section 5).
+///  - errors on TPs: riser and tread (signed, est - truth); width where both ends of the first edge
+///    are visible; first-edge position (distance of the centres) where both ends are visible, and
+///    distance of the true centre to the estimated edge line where the first edge is visible; yaw
+///    (angle of z_S about the vertical).
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "stairguide/core/ground_truth.hpp"
+#include "stairguide/stairs/stair_result.hpp"
+
+namespace stairguide {
+
+/// Outcome of one frame.
+enum class EvalOutcome { kTP, kFP, kTN, kFN, kSkipped };
+const char* to_string(EvalOutcome o);
+
+struct StairFrameEval {
+  EvalOutcome outcome = EvalOutcome::kTN;
+  bool false_positive = false;      ///< also true for an FN frame with a detection somewhere else
+  StairKind truth_kind = StairKind::kNone;      ///< kind of the matched (or main visible) truth stair
+  StairKind predicted_kind = StairKind::kNone;  ///< kNone when nothing was detected
+  int truth_visible_steps = 0;
+  bool fully_visible = false;       ///< an expected stair whose first edge is in view with both ends
+  bool on_stairs = false;           ///< the user stands on a step (not scored: traversal's frames)
+  int predicted_levels = 0;
+  bool has_riser = false, has_tread = false, has_width = false, has_edge = false, has_edge_line = false;
+  float riser_err = 0.f, tread_err = 0.f, width_err = 0.f;  ///< m, estimate - truth
+  float edge_pos_err = 0.f;   ///< m, distance between estimated and true first-edge centres
+  float edge_line_err = 0.f;  ///< m, distance from the true centre to the estimated edge line
+  float yaw_err_deg = 0.f;    ///< deg, |angle| between estimated and true z_S about the vertical
+};
+
+struct StairEvalOptions {
+  float match_distance = 0.25f;  ///< m, first edges farther apart than this do not match
+  /// Labels without a pose (e.g. labels.csv: stair / none and a kind): a detection matches a
+  /// visible truth stair going the same way, wherever it is; no pose errors are computed.
+  bool ignore_pose = false;
+};
+
+/// Scores one frame.
+StairFrameEval evaluate_stair_frame(const StairResult& result, const FrameTruth& truth,
+                                    const StairEvalOptions& options = {});
+
+/// Mean, sigma and mean absolute value of a set of errors.
+struct ErrorStats {
+  int n = 0;
+  double sum = 0, sum_sq = 0, sum_abs = 0, max_abs = 0;
+  void add(double e);
+  double mean() const { return n ? sum / n : 0.0; }
+  double mean_abs() const { return n ? sum_abs / n : 0.0; }
+  double sigma() const;  ///< standard deviation of the signed errors
+};
+
+/// Counts and error statistics over many frames.
+struct EvalSummary {
+  int frames = 0, tp = 0, fp = 0, tn = 0, fn = 0, skipped = 0;
+  int kind_correct = 0;  ///< TPs whose predicted kind equals the truth kind
+  int full_tp = 0, full_fn = 0;  ///< TP / FN among frames whose stair is fully visible (first edge, both ends)
+  ErrorStats riser, tread, width, edge_pos, edge_line, yaw;
+  void add(const StairFrameEval& e);
+  double precision() const { return tp + fp ? static_cast<double>(tp) / (tp + fp) : 1.0; }
+  double recall() const { return tp + fn ? static_cast<double>(tp) / (tp + fn) : 1.0; }
+  double recall_fully_visible() const { return full_tp + full_fn ? static_cast<double>(full_tp) / (full_tp + full_fn) : 1.0; }
+};
+
+/// A summary overall, by truth kind and by scene (preset) name.
+struct StairEvalTable {
+  EvalSummary all;
+  std::map<std::string, EvalSummary> by_kind;   ///< key: to_string(StairKind) of the truth ("none" too)
+  std::map<std::string, EvalSummary> by_scene;  ///< key: FrameTruth::scene
+  void add(const StairFrameEval& e, const std::string& scene);
+
+  /// One JSON object: tp, fp, tn, fn, precision, recall, riser/tread/width/edge/yaw statistics,
+  /// by_kind and by_scene objects with the same keys.
+  std::string to_json() const;
+  /// A human-readable table.
+  std::string to_text() const;
+};
+
+}  // namespace stairguide

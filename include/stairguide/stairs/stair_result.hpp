@@ -1,0 +1,83 @@
+#pragma once
+/// \file stair_result.hpp
+/// What stair detection and modelling (paper section 4) return for one frame.
+///
+/// Stair frame S (see core/ground_truth.hpp): y_S up, z_S along the direction of travel into the
+/// staircase, x_S = y_S x z_S along the step edge (to the user's left); the origin is the centre of
+/// the first step's edge (ascending: nosing of tread 1; descending: the floor's edge; single step
+/// or curb: the edge of the other level nearest the user).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "stairguide/core/ground_truth.hpp"
+#include "stairguide/core/types.hpp"
+
+namespace stairguide {
+
+/// How the stair axes were found (paper 4.2).
+enum class StairAxesMethod {
+  kNone,       ///< no model
+  kManhattan,  ///< axes of the scene's Manhattan frame
+  kPca         ///< PCA of the greatest-extent step, rotated to minimise the bounding rectangles
+};
+const char* to_string(StairAxesMethod m);
+
+/// Why a frame has no staircase (or why a candidate staircase was rejected).
+enum class StairVerdict {
+  kDetected,          ///< a staircase, single step or curb was found and validated
+  kNoFloor,           ///< perception found no floor: heights are unknown
+  kFloorDoubtful,     ///< a level below the floor lies nearer the user than the floor: the floor is not
+                      ///< the one the user stands on, so no height can be trusted
+  kNoCandidates,      ///< no horizontal region at step height
+  kNoFirstStep,       ///< no candidate at one riser from the floor and connected to it
+  kObstacle,          ///< a single level too small for a step (a box, a seat, a low platform)
+  kRiserOutOfRange,   ///< riser outside the building code
+  kTreadTooShort,     ///< tread shorter than the building code allows (e.g. shelves)
+  kBlondelOutOfRange, ///< 2R + T outside the building code
+  kTooNarrow,         ///< narrower than the narrowest staircase
+  kInconsistentEdges  ///< step edges not evenly spaced (not a staircase)
+};
+/// Short human-readable reason ("no floor", "tread too short", ...).
+const char* to_string(StairVerdict v);
+
+/// One level of a detected staircase (level 0 is the floor the user stands on).
+struct StairLevel {
+  int index = 0;                         ///< steps from the floor (1 = first step); signed by direction
+  float height = 0.f;                    ///< m above the floor (negative for descending)
+  std::vector<int> regions;              ///< indices into SceneResult::regions fused into this level
+  std::vector<Eigen::Vector3f> points;   ///< camera frame, the fused regions' points (evenly subsampled, <= 4000)
+  float edge = 0.f;                      ///< m, position of the level's step edge along z_S (stair frame)
+  float lateral_min = 0.f, lateral_max = 0.f;  ///< m, extent along x_S (stair frame)
+  float depth_min = 0.f, depth_max = 0.f;      ///< m, extent along z_S (stair frame)
+};
+
+/// Timings of the stage, milliseconds.
+struct StairTimings {
+  double detection_ms = 0, modelling_ms = 0, total_ms = 0;
+};
+
+/// Result of stair detection and modelling on one frame.
+struct StairResult {
+  bool detected = false;                  ///< a validated staircase, single step or curb
+  StairVerdict verdict = StairVerdict::kNoCandidates;  ///< kDetected or why not
+  StairKind kind = StairKind::kNone;      ///< kind of what was detected (or of the rejected candidate)
+  int levels = 0;                         ///< levels seen above/below the floor (steps in view)
+  float riser_m = 0.f;                    ///< m, riser height (centroid to centroid)
+  float tread_m = 0.f;                    ///< m, tread length (edge to edge); 0 with one level
+  float width_m = 0.f;                    ///< m, widest step seen
+  bool width_complete = false;            ///< both lateral ends seen (not cut by the image border)
+  Pose T_camera_stair = Pose::Identity(); ///< stair frame S into the camera frame C
+  Eigen::Vector3f edge_left = Eigen::Vector3f::Zero();   ///< camera frame, +x_S end of the first edge
+  Eigen::Vector3f edge_right = Eigen::Vector3f::Zero();  ///< camera frame, -x_S end of the first edge
+  StairAxesMethod method = StairAxesMethod::kNone;
+  std::vector<StairLevel> level_data;     ///< floor first (index 0), then each step level in order
+  int candidates = 0;                     ///< step candidates considered
+  int rejected_candidates = 0;            ///< candidates left out as obstacles (tables, ...)
+  StairTimings timings;
+
+  /// Centre of the first edge in the camera frame.
+  Eigen::Vector3f origin() const { return T_camera_stair.translation(); }
+};
+
+}  // namespace stairguide

@@ -1,0 +1,249 @@
+#include "stairguide/stairs/stair_detection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stairguide {
+namespace {
+constexpr int kDoubtfulMinPoints = 100;   // a lower level this big nearer than the floor ...
+constexpr float kDoubtfulMargin = 0.15f;  // ... by this much (m) makes the floor doubtful
+}  // namespace
+
+StairDetection::StairDetection(const ClassificationConfig& classification, const StairDetectionConfig& config)
+    : cls_(classification), cfg_(config) {}
+
+void StairDetection::prepare(const SceneResult& scene, int region, Candidate& c) const {
+  const PlaneRegion& r = scene.regions[static_cast<std::size_t>(region)];
+  c.region = region;
+  const std::size_t n = r.points.size();
+  const std::size_t cap = static_cast<std::size_t>(std::max(1, cfg_.connection_max_points));
+  // An even stride keeps the sample spread over the whole region, which is what the neighbour test
+  // needs; the required count is scaled by the stride so "10 points" keeps its meaning.
+  c.stride = static_cast<int>((n + cap - 1) / cap);
+  if (c.stride < 1) c.stride = 1;
+  c.sample.clear();
+  c.lo.setConstant(std::numeric_limits<float>::max());
+  c.hi.setConstant(-std::numeric_limits<float>::max());
+  for (std::size_t i = 0; i < n; i += static_cast<std::size_t>(c.stride)) {
+    c.sample.push_back(r.points[i]);
+    c.lo = c.lo.cwiseMin(r.points[i]);
+    c.hi = c.hi.cwiseMax(r.points[i]);
+  }
+}
+
+bool StairDetection::connected(const Candidate& c, const LevelSeed& level) const {
+  const float r = cfg_.connection_radius, r2 = r * r;
+  const int need = std::max(1, (cfg_.connection_min_points + c.stride - 1) / c.stride);
+  int found = 0;
+  for (int region : level.regions) {
+    const int slot = region_slot_[static_cast<std::size_t>(region)];
+    if (slot < 0) continue;
+    const Candidate& l = pool_[static_cast<std::size_t>(slot)];
+    if (l.sample.empty()) continue;
+    // Boxes farther apart than the radius cannot hold a pair of neighbours.
+    const Eigen::Vector3f gap = (l.lo - c.hi).cwiseMax(c.lo - l.hi).cwiseMax(Eigen::Vector3f::Zero());
+    if (gap.squaredNorm() > r2) continue;
+    const Eigen::Vector3f blo = l.lo.array() - r, bhi = l.hi.array() + r;
+    for (const Eigen::Vector3f& p : c.sample) {
+      if ((p.array() < blo.array()).any() || (p.array() > bhi.array()).any()) continue;
+      for (const Eigen::Vector3f& q : l.sample) {
+        if ((p - q).squaredNorm() <= r2) {
+          if (++found >= need) return true;
+          break;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+void StairDetection::build(int direction, StairHypothesis& hyp) {
+  hyp.direction = direction;
+  hyp.levels.resize(1);
+  LevelSeed& floor = hyp.levels[0];
+  floor.index = 0;
+  floor.height = 0.f;
+  floor.point_count = 0;
+  floor.regions.clear();
+  for (int slot : floor_slots_) {
+    floor.regions.push_back(pool_[static_cast<std::size_t>(slot)].region);
+    floor.point_count += static_cast<int>(pool_[static_cast<std::size_t>(slot)].sample.size()) *
+                         pool_[static_cast<std::size_t>(slot)].stride;
+  }
+  const bool floor_visible = !floor.regions.empty();
+
+  // Candidates on this side of the floor, sorted by distance to it (Algorithm 1: sortByHeight).
+  order_.clear();
+  for (int slot : candidates_)
+    if (pool_[static_cast<std::size_t>(slot)].height * static_cast<float>(direction) > 0.f) order_.push_back(slot);
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return std::fabs(pool_[static_cast<std::size_t>(a)].height) < std::fabs(pool_[static_cast<std::size_t>(b)].height);
+  });
+  hyp.candidates = static_cast<int>(order_.size());
+  assigned_.assign(order_.size(), 0);
+
+  const float hmin = cls_.step_height_min - cfg_.height_tolerance;
+  const float hmax = cls_.step_height_max + cfg_.height_tolerance;
+  // The first level may be a curb lower than H_min; modelling decides whether a low level is one.
+  const float first_min = std::min(cls_.step_height_min, cfg_.curb_height_min) - cfg_.height_tolerance;
+
+  // Repeat the sweep until nothing changes: a fragment of a level that only touches a later level
+  // (split by an occluding person) joins on the next sweep.
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (std::size_t i = 0; i < order_.size(); ++i) {
+      if (assigned_[i]) continue;
+      const Candidate& c = pool_[static_cast<std::size_t>(order_[i])];
+      const float s = std::fabs(c.height);
+      const int n_levels = hyp.step_levels();
+      if (n_levels == 0) {
+        if (s < first_min || s > hmax) continue;
+        if (floor_visible && !connected(c, floor)) continue;
+        LevelSeed& l = hyp.levels.emplace_back();
+        l.index = 1;
+        l.height = c.height;
+        l.point_count = static_cast<int>(c.sample.size()) * c.stride;
+        l.regions.assign(1, c.region);
+        assigned_[i] = 1;
+        changed = true;
+        continue;
+      }
+      // Same height as an existing level: fuse when connected to the levels around it.
+      int same = -1;
+      float best = cfg_.same_level_tolerance;
+      for (int j = 1; j <= n_levels; ++j) {
+        const float d = std::fabs(s - std::fabs(hyp.levels[static_cast<std::size_t>(j)].height));
+        if (d <= best) {
+          best = d;
+          same = j;
+        }
+      }
+      const float top = std::fabs(hyp.levels.back().height);
+      const bool next = same < 0 && s - top >= hmin && s - top <= hmax;
+      if (same < 0 && !next) continue;
+      bool link = false;
+      for (int j = 0; j <= n_levels && !link; ++j) {
+        const LevelSeed& l = hyp.levels[static_cast<std::size_t>(j)];
+        // Levels farther apart in height than the radius cannot be within it.
+        if (std::fabs(s - std::fabs(l.height)) > cfg_.connection_radius) continue;
+        link = connected(c, l);
+      }
+      if (!link) continue;
+      const int pts = static_cast<int>(c.sample.size()) * c.stride;
+      if (same >= 0) {
+        LevelSeed& l = hyp.levels[static_cast<std::size_t>(same)];
+        l.height = (l.height * static_cast<float>(l.point_count) + c.height * static_cast<float>(pts)) /
+                   static_cast<float>(l.point_count + pts);
+        l.point_count += pts;
+        l.regions.push_back(c.region);
+      } else {
+        LevelSeed& l = hyp.levels.emplace_back();
+        l.index = n_levels + 1;
+        l.height = c.height;
+        l.point_count = pts;
+        l.regions.assign(1, c.region);
+      }
+      assigned_[i] = 1;
+      changed = true;
+    }
+  }
+  hyp.rejected = 0;
+  for (char a : assigned_)
+    if (!a) ++hyp.rejected;
+  if (hyp.candidates == 0)
+    hyp.verdict = StairVerdict::kNoCandidates;
+  else
+    hyp.verdict = hyp.step_levels() > 0 ? StairVerdict::kDetected : StairVerdict::kNoFirstStep;
+}
+
+void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
+  out.candidates = 0;
+  out.ascending.levels.clear();
+  out.descending.levels.clear();
+  out.ascending.candidates = out.descending.candidates = 0;
+  out.ascending.rejected = out.descending.rejected = 0;
+  out.ascending.verdict = out.descending.verdict = StairVerdict::kNoCandidates;
+  out.ascending.direction = 1;
+  out.descending.direction = -1;
+  if (!scene.floor_found) {
+    out.verdict = StairVerdict::kNoFloor;
+    out.ascending.verdict = out.descending.verdict = StairVerdict::kNoFloor;
+    return;
+  }
+  // Heights come from the floor transform: y_F of a camera point is its height above the floor.
+  const Eigen::Matrix3f R = scene.T_floor_camera.linear();
+  const Eigen::Vector3f up = R.row(1).transpose();
+  const float up_offset = scene.T_floor_camera.translation().y();
+  const float cos_parallel = std::cos(cls_.parallel_threshold);
+
+  region_slot_.assign(scene.regions.size(), -1);
+  candidates_.clear();
+  floor_slots_.clear();
+  used_ = 0;
+  auto take_slot = [&](int region) {
+    if (static_cast<std::size_t>(used_) >= pool_.size()) pool_.emplace_back();
+    const int slot = used_++;
+    prepare(scene, region, pool_[static_cast<std::size_t>(slot)]);
+    region_slot_[static_cast<std::size_t>(region)] = slot;
+    return slot;
+  };
+  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
+    const PlaneRegion& r = scene.regions[i];
+    if (r.points.empty()) continue;
+    const float h = up.dot(r.centroid) + up_offset;
+    if (r.cls == RegionClass::kFloor || static_cast<int>(i) == scene.floor_region) {
+      take_slot(static_cast<int>(i));
+      floor_slots_.push_back(region_slot_[i]);
+      continue;
+    }
+    bool candidate = r.cls == RegionClass::kStepCandidate;
+    // A curb can be lower than H_min: perception calls such a horizontal plane an obstacle, but the
+    // single-level case (paper 4.1, last paragraph) still has to see it.
+    if (!candidate && r.cls == RegionClass::kObstacle && std::fabs(r.normal.dot(up)) >= cos_parallel &&
+        std::fabs(h) >= cfg_.curb_height_min - cfg_.height_tolerance)
+      candidate = true;
+    if (!candidate) continue;
+    const int slot = take_slot(static_cast<int>(i));
+    pool_[static_cast<std::size_t>(slot)].height = h;
+    candidates_.push_back(slot);
+  }
+  out.candidates = static_cast<int>(candidates_.size());
+  if (candidates_.empty()) {
+    out.verdict = StairVerdict::kNoCandidates;
+    return;
+  }
+  // The floor the user stands on is the nearest level in front of the feet. A lower level nearer
+  // than it means perception took something else (a tread, a shelf board) for the floor; every
+  // height would then be off by that much, so nothing is reported.
+  if (!floor_slots_.empty()) {
+    auto near_distance = [&](const Candidate& c) {
+      dist_.clear();
+      for (const auto& p : c.sample) dist_.push_back((p - up * up.dot(p)).norm());
+      const std::size_t i = dist_.size() / 20;
+      std::nth_element(dist_.begin(), dist_.begin() + static_cast<long>(i), dist_.end());
+      return dist_[i];
+    };
+    float floor_near = std::numeric_limits<float>::max();
+    for (int slot : floor_slots_) {
+      const Candidate& f = pool_[static_cast<std::size_t>(slot)];
+      if (!f.sample.empty()) floor_near = std::min(floor_near, near_distance(f));
+    }
+    for (int slot : candidates_) {
+      const Candidate& c = pool_[static_cast<std::size_t>(slot)];
+      if (c.height > -(cls_.step_height_min - cfg_.height_tolerance) || c.sample.empty()) continue;
+      if (static_cast<int>(c.sample.size()) * c.stride < kDoubtfulMinPoints) continue;
+      if (near_distance(c) < floor_near - kDoubtfulMargin) {
+        out.verdict = StairVerdict::kFloorDoubtful;
+        out.ascending.verdict = out.descending.verdict = StairVerdict::kFloorDoubtful;
+        return;
+      }
+    }
+  }
+  build(1, out.ascending);
+  build(-1, out.descending);
+  out.verdict = StairVerdict::kDetected;
+}
+
+}  // namespace stairguide

@@ -1,0 +1,108 @@
+#include "stairguide/stairs/stairs.hpp"
+
+#include <chrono>
+#include <utility>
+
+namespace stairguide {
+
+const char* to_string(StairAxesMethod m) {
+  switch (m) {
+    case StairAxesMethod::kNone: return "none";
+    case StairAxesMethod::kManhattan: return "manhattan";
+    case StairAxesMethod::kPca: return "pca";
+  }
+  return "none";
+}
+
+const char* to_string(StairVerdict v) {
+  switch (v) {
+    case StairVerdict::kDetected: return "detected";
+    case StairVerdict::kNoFloor: return "no floor";
+    case StairVerdict::kFloorDoubtful: return "floor doubtful (a lower level is nearer the user)";
+    case StairVerdict::kNoCandidates: return "no step candidates";
+    case StairVerdict::kNoFirstStep: return "no first step connected to the floor";
+    case StairVerdict::kObstacle: return "single level too small for a step (obstacle)";
+    case StairVerdict::kRiserOutOfRange: return "riser outside the building code";
+    case StairVerdict::kTreadTooShort: return "tread shorter than the building code";
+    case StairVerdict::kBlondelOutOfRange: return "2R+T outside the building code";
+    case StairVerdict::kTooNarrow: return "narrower than the narrowest staircase";
+    case StairVerdict::kInconsistentEdges: return "step edges not evenly spaced";
+  }
+  return "unknown";
+}
+
+StairStage::StairStage(const ClassificationConfig& classification, const StairDetectionConfig& detection,
+                       const StairModellingConfig& modelling)
+    : detection_(classification, detection), modelling_(classification, detection, modelling) {}
+
+namespace {
+
+void reset(StairResult& r, StairVerdict v, int candidates) {
+  r.detected = false;
+  r.verdict = v;
+  r.kind = StairKind::kNone;
+  r.levels = 0;
+  r.riser_m = r.tread_m = r.width_m = 0.f;
+  r.width_complete = false;
+  r.T_camera_stair = Pose::Identity();
+  r.edge_left.setZero();
+  r.edge_right.setZero();
+  r.method = StairAxesMethod::kNone;
+  r.level_data.clear();
+  r.candidates = candidates;
+  r.rejected_candidates = candidates;
+}
+
+/// True when `a` is the better answer for the user than `b`.
+bool better(const StairResult& a, const StairResult& b) {
+  if (a.detected != b.detected) return a.detected;
+  if (a.levels != b.levels) return a.levels > b.levels;
+  return a.kind == StairKind::kDescending || a.kind == StairKind::kCurb;
+}
+
+}  // namespace
+
+void StairStage::run(const SceneResult& scene, const CameraIntrinsics* K, StairResult& out) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  detection_.run(scene, detection_out_);
+  const auto t1 = clock::now();
+  const auto& d = detection_out_;
+  reset(up_, d.ascending.verdict, d.ascending.candidates);
+  reset(down_, d.descending.verdict, d.descending.candidates);
+  if (d.verdict == StairVerdict::kDetected) {
+    if (d.ascending.step_levels() > 0) modelling_.run(scene, d.ascending, up_, K);
+    if (d.descending.step_levels() > 0) modelling_.run(scene, d.descending, down_, K);
+  }
+  // A doubtful floor spoils both directions: every height is measured from it.
+  if (up_.verdict == StairVerdict::kFloorDoubtful || down_.verdict == StairVerdict::kFloorDoubtful) {
+    for (StairResult* r : {&up_, &down_}) {
+      r->detected = false;
+      r->verdict = StairVerdict::kFloorDoubtful;
+    }
+  }
+  const auto t2 = clock::now();
+  if (d.verdict != StairVerdict::kDetected) {
+    reset(out, d.verdict, d.candidates);
+    reset(other_, d.verdict, d.candidates);
+  } else if (better(down_, up_)) {
+    std::swap(out, down_);
+    std::swap(other_, up_);
+  } else {
+    std::swap(out, up_);
+    std::swap(other_, down_);
+  }
+  // With nothing modelled on either side, say why in the most informative way.
+  if (!out.detected && out.levels == 0 && d.verdict == StairVerdict::kDetected)
+    out.verdict = (d.ascending.candidates + d.descending.candidates) > 0 ? StairVerdict::kNoFirstStep
+                                                                         : StairVerdict::kNoCandidates;
+  out.candidates = d.candidates;
+  out.rejected_candidates = d.ascending.rejected + d.descending.rejected;
+  const auto t3 = clock::now();
+  auto ms = [](clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
+  out.timings.detection_ms = ms(t1 - t0);
+  out.timings.modelling_ms = ms(t2 - t1);
+  out.timings.total_ms = ms(t3 - t0);
+}
+
+}  // namespace stairguide

@@ -1,0 +1,219 @@
+// Stair detection and modelling end to end on the synthetic world: renderer -> perception ->
+// stairs, scored against the renderer's ground truth (issue 4's figures), plus the real frames of
+// ../shared/data as far as their labels allow.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "stairguide/capture/frame_source.hpp"
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/stairs/stairs.hpp"
+
+namespace {
+
+using namespace stairguide;
+
+/// Static presets: independent views, perception reset before each. Sequences: a window of
+/// consecutive frames from 40 % of the walk (the approach), perception tracking the floor as it
+/// does in use, after a few frames of warm-up that are not scored.
+constexpr int kStaticFrames = 16;
+constexpr int kSequenceFrames = 30;
+constexpr int kSequenceWarmup = 10;
+constexpr std::uint32_t kSeed = 5;
+
+struct Suite {
+  StairEvalTable table;
+  int frames = 0;
+  int floor_missing_fn = 0;  ///< FNs on frames where perception found no floor (or it was doubted)
+  std::vector<double> stage_ms;
+};
+
+const Suite& suite() {
+  static Suite s = [] {
+    Suite out;
+    const PipelineConfig cfg;
+    Perception perception(cfg);
+    StairStage stage(cfg);
+    SceneResult scene;
+    StairResult result;
+    RgbdFrame frame;
+    FrameTruth truth;
+    const synth::SynthOptions opt;
+    for (const auto& p : synth::presets()) {
+      const bool sequence = p.default_frames > 1;
+      const long first = sequence ? p.default_frames * 2 / 5 - kSequenceWarmup : 0;
+      const long count = sequence ? kSequenceWarmup + kSequenceFrames : kStaticFrames;
+      perception.reset();
+      for (long i = first; i < first + count; ++i) {
+        synth::render_preset_frame(p.name, i, kSeed, opt, frame, truth);
+        if (!sequence) perception.reset();  // independent views
+        perception.process(frame, scene);
+        stage.run(scene, frame.intrinsics, result);
+        if (sequence && i < first + kSequenceWarmup) continue;
+        const StairFrameEval e = evaluate_stair_frame(result, truth);
+        out.table.add(e, p.name);
+        out.stage_ms.push_back(result.timings.total_ms);
+        if (e.outcome == EvalOutcome::kFN && (result.verdict == StairVerdict::kNoFloor ||
+                                              result.verdict == StairVerdict::kFloorDoubtful))
+          ++out.floor_missing_fn;
+        ++out.frames;
+      }
+    }
+    std::printf("%s", out.table.to_text().c_str());
+    return out;
+  }();
+  return s;
+}
+
+TEST(StairsSynthetic, SuiteCoversEveryPresetWithEnoughFrames) {
+  const Suite& s = suite();
+  EXPECT_GE(s.frames, 300);
+  EXPECT_EQ(s.table.by_scene.size(), synth::presets().size());
+}
+
+TEST(StairsSynthetic, NoFalsePositives) {
+  const EvalSummary& a = suite().table.all;
+  EXPECT_EQ(a.fp, 0);
+  for (const auto& [name, sum] : suite().table.by_scene) EXPECT_EQ(sum.fp, 0) << name;
+}
+
+TEST(StairsSynthetic, DetectsStaircasesInView) {
+  const Suite& s = suite();
+  const EvalSummary& a = s.table.all;
+  std::printf("recall %.4f (%d TP, %d FN; %d FN where perception had no trustworthy floor), "
+              "fully visible %.4f (%d frames)\n",
+              a.recall(), a.tp, a.fn, s.floor_missing_fn, a.recall_fully_visible(), a.full_tp + a.full_fn);
+  // Issue 4 asks for 99 % on frames with two or more steps fully visible: NOT reached (measured
+  // 0.91 over fully visible stairs, 0.93 where perception gave a trustworthy floor). The bounds
+  // below are the measured figures less a margin, so a regression fails; the misses are far,
+  // grazing views (tread shorter than the code), people hiding treads, and frames perception
+  // leaves without a floor or with a tread taken for it.
+  const int stage_fn = a.fn - s.floor_missing_fn;
+  const double stage_recall = static_cast<double>(a.tp) / (a.tp + stage_fn);
+  std::printf("recall of the stairs stage where perception found the floor: %.4f\n", stage_recall);
+  EXPECT_GE(stage_recall, 0.90);
+  // The overall figures depend on perception's floor too (which is still changing): a loose guard.
+  EXPECT_GE(a.recall(), 0.75);
+  EXPECT_GE(a.recall_fully_visible(), 0.80);
+  for (const char* kind : {"ascending", "descending"}) {
+    const auto it = s.table.by_kind.find(kind);
+    ASSERT_NE(it, s.table.by_kind.end()) << kind;
+    EXPECT_GE(it->second.tp, 15) << kind;
+  }
+}
+
+TEST(StairsSynthetic, SingleStepsAndCurbsToldApartFromFurniture) {
+  const auto& sc = suite().table.by_scene;
+  for (const char* name : {"table_static", "bench_static", "shelves_static", "low_platform_static", "sofa_static",
+                           "corridor_static", "room_clutter_static", "floor_only_static"}) {
+    const EvalSummary& s = sc.at(name);
+    EXPECT_EQ(s.fp, 0) << name;
+    EXPECT_EQ(s.tn, s.frames) << name;
+  }
+  for (const char* name : {"single_step_static", "curb_static"}) {
+    const EvalSummary& s = sc.at(name);
+    EXPECT_GE(s.tp, 8) << name;
+    EXPECT_GE(s.recall(), 0.8) << name;
+    // A platform 2.5 m wide and deep filling the view cannot be told from another floor level:
+    // some single steps come out as curbs (measured 10 of 13); curbs come out as curbs.
+    EXPECT_GE(4 * s.kind_correct, 3 * s.tp) << name << ": single step taken for a curb or back";
+  }
+}
+
+TEST(StairsSynthetic, DimensionsAndPose) {
+  const EvalSummary& a = suite().table.all;
+  std::printf("riser |err| %.2f cm sigma %.2f (n %d); tread %.2f sigma %.2f (n %d); width %.2f sigma %.2f (n %d)\n"
+              "edge position %.2f cm (n %d), edge line %.2f cm (n %d), yaw %.2f deg sigma %.2f\n",
+              100 * a.riser.mean_abs(), 100 * a.riser.sigma(), a.riser.n, 100 * a.tread.mean_abs(),
+              100 * a.tread.sigma(), a.tread.n, 100 * a.width.mean_abs(), 100 * a.width.sigma(), a.width.n,
+              100 * a.edge_pos.mean_abs(), a.edge_pos.n, 100 * a.edge_line.mean_abs(), a.edge_line.n, a.yaw.mean_abs(),
+              a.yaw.sigma());
+  EXPECT_GE(a.riser.n, 80);
+  EXPECT_GE(a.tread.n, 50);
+  EXPECT_LE(a.riser.mean_abs(), 0.01);
+  EXPECT_LE(a.riser.sigma(), 0.01);
+  EXPECT_LE(a.tread.mean_abs(), 0.01);
+  EXPECT_LE(a.tread.sigma(), 0.01);
+  EXPECT_LE(a.width.mean_abs(), 0.05);
+  EXPECT_LE(a.edge_pos.mean_abs(), 0.03);
+  EXPECT_LE(a.edge_line.mean_abs(), 0.03);
+  EXPECT_LE(a.yaw.mean_abs(), 2.0);
+}
+
+TEST(StairsSynthetic, StageIsFast) {
+  // Not a benchmark (that is `stairguide bench stairs`): a guard against a gross regression only.
+  std::vector<double> t = suite().stage_ms;
+  std::sort(t.begin(), t.end());
+  const double median = t[t.size() / 2];
+  std::printf("stairs stage median %.3f ms, p95 %.3f ms (debug guard, not the benchmark)\n", median,
+              t[t.size() * 95 / 100]);
+  EXPECT_LT(median, 20.0);
+}
+
+// ---- real frames: ../shared/data/labels.csv ----
+
+std::vector<std::vector<std::string>> read_labels(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::vector<std::string> f(1);
+    bool q = false;
+    for (char c : line) {
+      if (c == '"') q = !q;
+      else if (c == ',' && !q) f.emplace_back();
+      else f.back() += c;
+    }
+    if (f.size() >= 2) rows.push_back(f);
+  }
+  return rows;
+}
+
+TEST(StairsReal, LabelledFrames) {
+  const std::string dir = STAIRGUIDE_SHARED_DATA;
+  const std::string labels = dir + "/labels.csv";
+  if (!std::filesystem::exists(labels)) GTEST_SKIP() << "no shared data at " << dir;
+  const PipelineConfig cfg;
+  Perception perception(cfg);
+  StairStage stage(cfg);
+  int none_frames = 0, none_detected = 0, stair_frames = 0, stair_detected = 0, wrong_direction = 0;
+  for (const auto& row : read_labels(labels)) {
+    std::unique_ptr<FrameSource> src;
+    try {
+      src = open_frame_source(dir + "/" + row[0], cfg.capture);
+    } catch (const SourceError& e) {
+      ADD_FAILURE() << e.what();
+      continue;
+    }
+    RgbdFrame frame;
+    ASSERT_TRUE(src->read(frame).ok()) << row[0];
+    perception.reset();
+    const SceneResult scene = perception.process(frame);
+    StairResult r;
+    stage.run(scene, frame.intrinsics, r);
+    std::printf("%-75s %-6s -> %s%s%s (%s)\n", row[0].c_str(), row[1].c_str(), r.detected ? to_string(r.kind) : "none",
+                scene.floor_found ? "" : ", no floor", "", to_string(r.verdict));
+    if (row[1] == "none") {
+      ++none_frames;
+      none_detected += r.detected;
+    } else {
+      ++stair_frames;
+      stair_detected += r.detected;
+      // Every stair frame of the set is ascending: a detection must not say descending.
+      if (r.detected && (r.kind == StairKind::kDescending || r.kind == StairKind::kCurb)) ++wrong_direction;
+    }
+  }
+  std::printf("real frames: 'none' %d of %d detected; 'stair' %d of %d detected\n", none_detected, none_frames,
+              stair_detected, stair_frames);
+  EXPECT_EQ(none_frames, 7);
+  EXPECT_EQ(none_detected, 0) << "a staircase reported in a frame without one";
+  EXPECT_EQ(wrong_direction, 0);
+}
+
+}  // namespace
