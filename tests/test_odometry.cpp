@@ -382,18 +382,25 @@ TEST(DenseOdometrySequence, SyntheticFastTurnBeatsReference) {
 }
 
 TEST(DenseOdometrySequence, RealKitchenNotWorseThanReference) {
+  // The whole 300-frame sequence (not a window chosen where we win): RPE over 1 s and ATE must
+  // not be worse than OpenCV RgbdOdometry's on the same frames. Measured (keyframes on):
+  // ours 0.0286 m/s, 1.33 deg/s, ATE 22.7 mm; reference 0.0302 m/s, 1.77 deg/s, ATE 24.8 mm.
   const std::string dir = std::string(STAIRGUIDE_SHARED_DATA) + "/7scenes-redkitchen-0000-0299";
   if (!std::filesystem::exists(dir + "/groundtruth.txt")) GTEST_SKIP() << "no shared data at " << dir;
   DatasetSource src(dir);
-  const SequenceRun run = run_sequence(src, 90, false, read_groundtruth(dir + "/groundtruth.txt"));
-  ASSERT_GE(run.truth.size(), 85u);
+  const SequenceRun run = run_sequence(src, 300, false, read_groundtruth(dir + "/groundtruth.txt"));
+  ASSERT_GE(run.truth.size(), 295u);
   const RpeResult ours = relative_pose_error(run.ours, run.truth),
                   ref = relative_pose_error(run.ref, run.truth);
-  std::printf("7-Scenes kitchen, 90 frames: RPE ours %.4f m/s %.3f deg/s, reference %.4f m/s %.3f deg/s\n",
-              ours.translation_m_s.rmse(), ours.rotation_deg_s.rmse(), ref.translation_m_s.rmse(),
-              ref.rotation_deg_s.rmse());
+  const double ate_ours = absolute_trajectory_error(run.ours, run.truth).rmse(),
+               ate_ref = absolute_trajectory_error(run.ref, run.truth).rmse();
+  std::printf("7-Scenes kitchen, 300 frames: RPE ours %.4f m/s %.3f deg/s ATE %.4f m, reference %.4f m/s %.3f "
+              "deg/s ATE %.4f m\n",
+              ours.translation_m_s.rmse(), ours.rotation_deg_s.rmse(), ate_ours, ref.translation_m_s.rmse(),
+              ref.rotation_deg_s.rmse(), ate_ref);
   EXPECT_EQ(run.failures, 0);
   EXPECT_LE(ours.translation_m_s.rmse(), ref.translation_m_s.rmse());
   EXPECT_LE(ours.rotation_deg_s.rmse(), ref.rotation_deg_s.rmse());
-  EXPECT_LE(ours.translation_m_s.rmse(), 0.06);  // measured 0.035 m/s over the 300 frames
+  EXPECT_LE(ate_ours, ate_ref);
+  EXPECT_LE(ours.translation_m_s.rmse(), 0.032);  // frame to frame only, it was 0.0353 m/s
 }

@@ -262,6 +262,7 @@ struct DenseOdometry::Impl {
   double last_timestamp = 0.0;
   bool has_last_timestamp = false;
   int consecutive_failures = 0;
+  bool prev_skipped = false;  // the last output frame was an unusable frame placed by the guess
 
   std::array<Scratch*, kParts> scratch{};
   std::vector<Scratch> scratch_store;
@@ -301,6 +302,7 @@ struct DenseOdometry::Impl {
     velocity_dt = 0.0;
     has_last_timestamp = false;
     consecutive_failures = 0;
+    prev_skipped = false;
   }
 
   void allocate() {
@@ -795,9 +797,11 @@ struct DenseOdometry::Impl {
         ref = 1 - ref;
         has_ref = true;
         T_last_ref.setIdentity();
+        prev_skipped = false;
       } else {
         // Keep the old reference and remember where the guess put this frame relative to it.
         T_last_ref = step * T_last_ref;
+        prev_skipped = true;
       }
       last_timestamp = f.timestamp;
       has_last_timestamp = true;
@@ -896,13 +900,28 @@ struct DenseOdometry::Impl {
     // Velocity for the next frame; its time span when timestamps are usable.
     velocity = T_prev_curr.inverse();
     const double dt = f.timestamp - last_timestamp;
-    velocity_dt = (has_last_timestamp && dt > 0.0 && T_last_ref.matrix().isIdentity(1e-12)) ? dt : 0.0;
+    velocity_dt = (has_last_timestamp && dt > 0.0 && !prev_skipped) ? dt : 0.0;
     last_timestamp = f.timestamp;
     has_last_timestamp = true;
+    prev_skipped = false;
 
-    build_reference(cur);
-    ref = 1 - ref;
-    T_last_ref.setIdentity();
+    // Keyframe policy: keep tracking against the same reference while it is close and still
+    // overlaps well. Each frame-to-frame estimate carries a bias toward zero motion (the sensor's
+    // fixed-pattern depth noise and the camera's vignetting stay put in the image and pull the
+    // alignment toward identity), and chaining one estimate per frame adds that bias up; against
+    // a keyframe it is paid once per keyframe instead.
+    const double ref_trans = s.G.translation().norm();
+    const double ref_rot = Eigen::AngleAxisd(s.G.linear()).angle();
+    const double overlap = ref_points(0) > 0 ? static_cast<double>(s.last.used) / ref_points(0) : 0.0;
+    const bool keep = cfg.keyframe_max_translation > 0.f && ref_trans < cfg.keyframe_max_translation &&
+                      ref_rot < cfg.keyframe_max_rotation && overlap >= cfg.keyframe_min_overlap;
+    if (keep) {
+      T_last_ref = s.G;
+    } else {
+      build_reference(cur);
+      ref = 1 - ref;
+      T_last_ref.setIdentity();
+    }
     return res;
   }
 };

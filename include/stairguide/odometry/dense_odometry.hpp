@@ -5,6 +5,10 @@
 /// minimised jointly by iteratively reweighted least squares with Student-t weights, coarse to
 /// fine over an image pyramid, the SE(3) update of eq. 13, constant-velocity initialisation.
 ///
+/// Each frame is tracked against a reference (keyframe) that is kept while the camera stays within
+/// OdometryConfig::keyframe_max_translation / keyframe_max_rotation of it and it still overlaps
+/// (keyframe_min_overlap); keyframe_max_translation = 0 gives pure frame-to-frame tracking.
+///
 /// The stage is pure: no threads unless `OdometryConfig::threads == 2` asks for a helper over
 /// image rows, no logging, no I/O, no exceptions on the per-frame path. After the first frame
 /// of a given size, `track()` allocates nothing.
