@@ -55,7 +55,9 @@ FloorDetector::Reach FloorDetector::reach(const PlaneRegion& r) {
   // 2nd percentiles: robust to stray points.
   Reach out;
   // Every other point of the (already subsampled) region is plenty for a 2nd percentile.
-  const std::size_t step = r.points.size() > 400 ? 2 : 1;
+  // About 4000 evenly spread points give the 2nd percentile to well under a pixel's spacing, and
+  // keep this linear pass and the selection cheap on a floor of tens of thousands of points.
+  const std::size_t step = r.points.size() > 400 ? std::max<std::size_t>(2, r.points.size() / 4000) : 1;
   near_buf_.clear();
   for (std::size_t k = 0; k < r.points.size(); k += step) near_buf_.push_back(foot_distance(r.normal, r.points[k]));
   out.distance = percentile(near_buf_, 20);
@@ -196,6 +198,18 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
       est.why = "the tracked floor is out of view and the planes in view are at another level (steps)";
       return lost(est);
     }
+  } else if (prev_) {
+    // Held no longer, but the camera's height above what the user stands on is a property of the
+    // user, not of the place: on a staircase the tread underfoot is at the remembered height while
+    // the treads and the landing below are a riser or more lower. A plane that much lower is
+    // never the floor; with the tread underfoot out of view, no floor is reported.
+    cand.erase(std::remove_if(cand.begin(), cand.end(),
+                              [&](int i) { return regions[i].offset - prev_->offset > cfg_.track_max_height_jump; }),
+               cand.end());
+    if (cand.empty()) {
+      est.why = "the planes in view are a riser or more below the remembered floor (treads below the user)";
+      return lost(est);
+    }
   }
 
   // Choose, verify, and on failure drop every candidate on the rejected plane and choose again:
@@ -252,7 +266,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
 }
 
 FloorEstimate& FloorDetector::lost(FloorEstimate& est) {
-  if (prev_ && ++lost_frames_ >= cfg_.track_hold_frames) prev_.reset();
+  if (prev_ && ++lost_frames_ >= std::max(cfg_.track_hold_frames, cfg_.track_forget_frames)) prev_.reset();
   return est;
 }
 
@@ -261,7 +275,7 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
   tracked = false;
   // Tracking: the previous floor, when it is still in view, stays the floor.
   int chosen = -1;
-  if (prev_) {
+  if (prev_ && lost_frames_ < cfg_.track_hold_frames) {
     float best = 0.f;
     for (int i : cand) {
       const PlaneRegion& r = regions[i];

@@ -167,8 +167,14 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
   if (cell < 2) return;
   cells_.clear();
   const int need = (cell * cell * 4) / 5;
+  const int cs = std::max(2, cfg_.cell_size_px);
   for (int v0 = 0; v0 + cell <= H_; v0 += cell) {
     for (int u0 = 0; u0 + cell <= W_; u0 += cell) {
+      // A fine cell wholly inside a coarse cell that joined a region has no free pixel left.
+      const int cu = u0 / cs, cv = v0 / cs;
+      if (cu == (u0 + cell - 1) / cs && cv == (v0 + cell - 1) / cs && cu < CW_ && cv < CH_ &&
+          cell_label_[static_cast<std::size_t>(cv * CW_ + cu)] >= 0)
+        continue;
       InvDepthMoments m;
       int cnt = 0;
       for (int v = v0; v < v0 + cell; ++v) {
@@ -561,30 +567,47 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
     if (map[r] >= 0) regions[map[r]].pixels.reserve(static_cast<std::size_t>(grows[r].count));
   // One raster pass: pixels, points, centroid, footprint area, moments for the principal axes.
   const int stride = std::max(1, cfg_.points_stride_px);
+  // Labels come in long horizontal runs (a tread spans hundreds of pixels of a row): handle each
+  // run at once, so the per-pixel work is a label compare and a sequential store.
   for (int v = 0; v < H_; ++v) {
     const bool vrow = v % stride == 0;
-    for (int u = 0; u < W_; ++u) {
-      const int p = v * W_ + u;
-      const int l = label_[p];
-      if (l < 0) continue;
-      const int id = map[l];
-      label_[p] = id;
-      if (id < 0) continue;
-      PlaneRegion& R = regions[id];
-      RegionAcc& A = acc_[id];
-      R.pixels.push_back(p);
-      // Centroid, footprint and axes from the point subsample (every stride-th pixel both ways):
-      // smooth sums that need not visit every pixel.
-      if (vrow && u % stride == 0) {
-        const float z = z_[p];
-        const float x = un_[u] * z, y = vn_[v] * z;
-        R.points.emplace_back(x, y, z);
-        A.sx += x;
-        A.sy += y;
-        A.sz += z;
-        A.z3 += double(z) * z * z;
-        A.m.add(x, y, z);
+    int* lab = &label_[static_cast<std::size_t>(v) * W_];
+    const int row0 = v * W_;
+    const float vv = vn_[v];
+    const float* zr = &z_[static_cast<std::size_t>(v) * W_];
+    int u = 0;
+    while (u < W_) {
+      const int l = lab[u];
+      if (l < 0) {
+        ++u;
+        continue;
       }
+      int e = u + 1;
+      while (e < W_ && lab[e] == l) ++e;
+      const int id = map[l];
+      std::fill(lab + u, lab + e, id);
+      if (id >= 0) {
+        PlaneRegion& R = regions[id];
+        const std::size_t old = R.pixels.size();
+        R.pixels.resize(old + static_cast<std::size_t>(e - u));
+        std::iota(R.pixels.begin() + static_cast<long>(old), R.pixels.end(), row0 + u);
+        // Centroid, footprint and axes from the point subsample (every stride-th pixel both
+        // ways): smooth sums that need not visit every pixel.
+        if (vrow) {
+          RegionAcc& A = acc_[id];
+          for (int uu = ((u + stride - 1) / stride) * stride; uu < e; uu += stride) {
+            const float z = zr[uu];
+            const float x = un_[uu] * z, y = vv * z;
+            R.points.emplace_back(x, y, z);
+            A.sx += x;
+            A.sy += y;
+            A.sz += z;
+            A.z3 += double(z) * z * z;
+            A.m.add(x, y, z);
+          }
+        }
+      }
+      u = e;
     }
   }
   const float area_k = 1.f / (K_.fx * K_.fy);
