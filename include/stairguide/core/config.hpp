@@ -115,6 +115,7 @@ struct FloorConfig {
   float track_max_angle_jump = 0.17453293f;  ///< rad, change of floor normal accepted between frames
   float horizontal_tolerance = 0.17453293f;  ///< rad, floor candidates vs the tracked floor normal (10 deg)
   int track_hold_frames = 15;     ///< frames the tracked floor is held after it was last seen
+  int track_forget_frames = 300;  ///< frames the user's camera height is remembered after the floor was last seen
   float verify_drop = 0.06f;      ///< m, a point this far below a floor candidate counts as "below"
   float verify_margin_angle = 0.0087266f;  ///< rad, "nearer the user": this much nearer the nadir than the candidate's near edge (0.5 deg)
   float view_edge_angle = 0.034906585f;    ///< rad, a plane within this of the view's bottom edge "starts at the edge" (2 deg)
@@ -144,6 +145,9 @@ struct FloorConfig {
           "a plane parallel to the floor within this is a second floor candidate (never taken when nearer the camera)");
     v.num(track_hold_frames, "track_hold_frames", Unit::kCount, 0, 1000,
           "frames the tracked floor is held after it was last seen (no other level taken meanwhile)");
+    v.num(track_forget_frames, "track_forget_frames", Unit::kCount, 0, 100000,
+          "frames the camera height above the floor is remembered after the floor was last seen: meanwhile a "
+          "plane a riser or more lower (a tread below the user) is never taken for the floor");
     v.num(verify_drop, "verify_drop_cm", Unit::kCentimetre, 1, 100,
           "floor check: a point this far below a candidate counts as below it");
     v.num(verify_margin_angle, "verify_margin_deg", Unit::kDegree, 0, 30,
@@ -279,6 +283,9 @@ struct OdometryConfig {
   float min_update_rotation = 1.745e-4f; ///< rad (0.01 deg)
   float min_inlier_fraction = 0.5f; ///< share of used pixels with both residuals within 3 sigma
   bool adaptive_scale = true;       ///< weight scales follow the residuals while above sigma_I / sigma_W
+  float keyframe_max_translation = 0.10f; ///< m from the reference frame beyond which the current frame becomes it (0: frame to frame)
+  float keyframe_max_rotation = 0.1047f;  ///< rad from the reference frame beyond which the current frame becomes it
+  float keyframe_min_overlap = 0.6f;      ///< share of the reference's finest-level points still matched, below which a new reference is taken
 
   template <class V> void visit(V& v) {
     v.num(sigma_intensity, "sigma_intensity", Unit::kNone, 0.01, 255, "photometric scale sigma_I, grey levels 0-255");
@@ -303,6 +310,12 @@ struct OdometryConfig {
           "share of used pixels whose residuals are within 3 sigma, below which the estimate is a failure");
     v.flag(adaptive_scale, "adaptive_scale",
            "far from the solution, scale the Student-t weights by the residuals' own spread (never below sigma_I, sigma_W)");
+    v.num(keyframe_max_translation, "keyframe_max_translation_cm", Unit::kCentimetre, 0, 100,
+          "track against one reference (keyframe) until the camera is this far from it; 0 = frame to frame");
+    v.num(keyframe_max_rotation, "keyframe_max_rotation_deg", Unit::kDegree, 0, 90,
+          "track against one reference (keyframe) until the camera has turned this much from it");
+    v.num(keyframe_min_overlap, "keyframe_min_overlap_percent", Unit::kPercent, 0, 100,
+          "share of the reference's points still matched in the current frame below which it is replaced");
   }
 };
 
