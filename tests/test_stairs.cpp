@@ -209,6 +209,34 @@ TEST(StairsUnit, SingleStepCurbAndObstacle) {
   }
 }
 
+TEST(StairsUnit, FarDropSeenOnlyPastTheFloorEdge) {
+  // Far away, a descending flight shows only the strip of its first tread that lies past the
+  // shadow of the floor's edge (D * R / H beyond it): a drop however shallow the strip. The same
+  // strip well past that shadow is no drop seen over the edge, and stays an obstacle.
+  StairStage stage(cfg());
+  StairResult r;
+  const float H = 1.3f, R = 0.17f, D = 1.5f, shadow = D * R / H;
+  {
+    SceneBuilder b(H, 45.f, 21);
+    b.add_floor(D);
+    b.add_box_top(0.f, D + shadow + 0.015f, 1.2f, 0.03f, -R, RegionClass::kStepCandidate);
+    stage.run(b.scene, r);
+    ASSERT_TRUE(r.detected) << to_string(r.verdict);
+    EXPECT_EQ(r.kind, StairKind::kCurb);  // one level below: a drop (curb or flight, cannot tell)
+    EXPECT_NEAR(r.riser_m, R, 0.01f);
+    const Eigen::Vector3f o = b.scene.T_floor_camera * r.origin();
+    EXPECT_NEAR(o.z(), D, 0.03f);
+  }
+  {
+    SceneBuilder b(H, 45.f, 22);
+    b.add_floor(D);
+    b.add_box_top(0.f, D + shadow + 0.17f, 1.2f, 0.03f, -R, RegionClass::kStepCandidate);
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.verdict, StairVerdict::kObstacle);
+  }
+}
+
 TEST(StairsUnit, NoFloorNoStairs) {
   SceneBuilder b(1.3f, 45.f, 1);
   StairSpec s;

@@ -614,6 +614,81 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   const LineFit hfit = fit_line(fit_k_, fit_e_);
   float riser = n >= 2 ? std::fabs(hfit.slope) : std::fabs(fit_e_[1]);
 
+  // ---- risers: where a tread's near edge is hidden, its riser shows where the step starts ----
+  // Seen at a grazing angle, the first pixel rows of a tread behind its nosing are mixed with the
+  // riser below and left out of the tread's region (or the image border takes them): its near
+  // edge then comes out too far, and the tread too long or short. The riser below that edge
+  // faces the user and is measured over many pixels. Ascending only (a descending flight turns its
+  // risers away). The riser plane lies a nosing (a few cm) before the edge; where the tread's
+  // edge lies beyond its riser by more than that, the riser (plus the nosing measured on the
+  // levels where both agree) stands for the edge. A riser only ever moves an edge nearer.
+  if (dir > 0 && n >= 2) {
+    riser_at_.assign(static_cast<std::size_t>(n + 1), std::numeric_limits<float>::quiet_NaN());
+    riser_n_.assign(static_cast<std::size_t>(n + 1), 0);
+    const float sin_vert = std::sin(cls_.parallel_threshold), cos_face = std::cos(cls_.parallel_threshold);
+    for (const PlaneRegion& r : scene.regions) {
+      if (r.points.size() < 40 || std::fabs(r.normal.dot(up)) > sin_vert || std::fabs(r.normal.dot(zs)) < cos_face)
+        continue;
+      const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 300);
+      tmp_.clear();
+      a_.clear();
+      b_.clear();
+      for (std::size_t i = 0; i < r.points.size(); i += stride) {
+        const Eigen::Vector3f& p = r.points[i];
+        tmp_.push_back(up.dot(p) - levels_[0].plane);
+        a_.push_back(xs.dot(p));
+        b_.push_back(zs.dot(p));
+      }
+      std::sort(tmp_.begin(), tmp_.end());
+      const float h_lo = tmp_[tmp_.size() / 10], h_hi = tmp_[tmp_.size() * 9 / 10];
+      // Which riser: the band between two consecutive levels that holds the region.
+      int k = 0;
+      for (int j = 1; j <= n; ++j) {
+        const float below = j == 1 ? 0.f : levels_[static_cast<std::size_t>(j - 1)].plane - levels_[0].plane;
+        const float above = levels_[static_cast<std::size_t>(j)].plane - levels_[0].plane;
+        if (h_lo >= below - 0.03f && h_hi <= above + 0.03f && h_hi - h_lo >= 0.3f * (above - below)) k = j;
+      }
+      if (k == 0) continue;
+      const auto mid_a = a_.begin() + static_cast<long>(a_.size() / 2);
+      std::nth_element(a_.begin(), mid_a, a_.end());
+      if (*mid_a < a_min || *mid_a > a_max) continue;  // beside the staircase (a wall's end, a door)
+      const auto mid_b = b_.begin() + static_cast<long>(b_.size() / 2);
+      std::nth_element(b_.begin(), mid_b, b_.end());
+      const float pos = *mid_b;
+      // It must stand between the previous tread's start and its own tread's (seen) edge.
+      const StairLevel& lk = out.level_data[static_cast<std::size_t>(k)];
+      if (pos > lk.edge + cfg_.edge_max_residual) continue;
+      if (k > 1 && pos < out.level_data[static_cast<std::size_t>(k - 1)].depth_min + 0.1f) continue;
+      if (static_cast<int>(r.points.size()) > riser_n_[static_cast<std::size_t>(k)]) {
+        riser_n_[static_cast<std::size_t>(k)] = static_cast<int>(r.points.size());
+        riser_at_[static_cast<std::size_t>(k)] = pos;
+      }
+    }
+    // Nosing: the edge-to-riser offset where both agree (0 when none does).
+    constexpr float kMaxNosing = 0.05f;
+    tmp_.clear();
+    for (int k = 1; k <= n; ++k) {
+      const float d = out.level_data[static_cast<std::size_t>(k)].edge - riser_at_[static_cast<std::size_t>(k)];
+      if (std::isfinite(d) && d >= -0.02f && d <= kMaxNosing) tmp_.push_back(d);
+    }
+    float nosing = 0.f;
+    if (!tmp_.empty()) {
+      std::sort(tmp_.begin(), tmp_.end());
+      nosing = tmp_[tmp_.size() / 2];
+    }
+    // Seen nearer the horizontal than the vertical, the risers face the camera more than the
+    // treads do and are the better measure of every step's start; otherwise a riser replaces only
+    // an edge that lies beyond it by more than a nosing (the tread's near rows hidden).
+    const Eigen::Vector3f ray = (xs * 0.5f * (a_min + a_max) + up * levels_[1].plane +
+                                 zs * out.level_data[1].edge).normalized();
+    const bool grazing = std::fabs(ray.dot(zs)) > std::fabs(ray.dot(up));
+    for (int k = 1; k <= n; ++k) {
+      StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
+      const float rk = riser_at_[static_cast<std::size_t>(k)];
+      if (std::isfinite(rk) && (grazing || o.edge - rk > kMaxNosing)) o.edge = rk + nosing;
+    }
+  }
+
   // ---- tread: slope of the step edges against the level index ----
   LineFit efit;
   float edge_residual = 0.f;
@@ -806,10 +881,28 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     out.kind = (dir < 0 || depth >= det_.curb_min_depth || (cut == 2 && far_cut)) ? StairKind::kCurb
                                                                                  : StairKind::kSingleStep;
     const float min_width = det_.single_min_width;
+    // A level below the floor is hidden behind the floor's edge up to the edge's shadow: from the
+    // camera (height H above the floor, D in front of the edge) a drop of R is seen from D * R / H
+    // beyond the edge on. A far descending flight shows only that strip of its first tread, so
+    // its seen depth says nothing; a strip that starts right at the shadow of the floor's edge is
+    // a drop, however shallow.
+    bool shadowed_drop = false;
+    if (dir < 0 && floor_edge) {
+      const Eigen::Vector3f cam = out.T_camera_stair.inverse().translation();  // camera in S
+      const float H = cam.y(), D = -cam.z();
+      if (H > 0.3f && D > 0.f) {
+        const float shadow = D * riser / H;
+        // Slack: the edge and the strip's near boundary are each measured to a few cm, worse far.
+        const float slack = 0.04f + 0.01f * D * D;
+        shadowed_drop = std::fabs(o.depth_min - shadow) < slack;
+      }
+    }
     // Seen shallower than a step platform: an obstacle, unless it runs out of view at the far side
-    // and on both sides while wider than any furniture board (then it is another floor level).
+    // and on both sides while wider than any furniture board (then it is another floor level), or
+    // is the strip of a drop seen past the floor's edge.
     const bool too_small = width < min_width - tol ||
-                           (depth < det_.single_min_depth - tol && !(far_cut && cut == 2 && width >= kOtherFloorWidth));
+                           (depth < det_.single_min_depth - tol &&
+                            !(far_cut && cut == 2 && width >= kOtherFloorWidth) && !shadowed_drop);
     if (too_small) {
       out.verdict = StairVerdict::kObstacle;
       return;

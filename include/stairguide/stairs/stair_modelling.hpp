@@ -14,13 +14,16 @@
 ///   along the ray, so this removes most of it), then each level's step edge is found in z_S:
 ///   ascending, the near edge of each tread (its nosing); descending, the far edge of each level
 ///   (the floor's far edge is the first). Edges are extrapolated from two low quantiles, which is
-///   unbiased for evenly spread points and insensitive to a few strays.
+///   unbiased for evenly spread points and insensitive to a few strays. Ascending, the risers
+///   facing the user place the edges in grazing views, and replace an edge whose tread's near rows
+///   are hidden (one lying more than a nosing beyond its riser).
 /// - Tread: slope of the edge positions against the level index (edge to edge); riser: slope of the
 ///   level heights (centroid to centroid, the floor included); width: lateral extent of all steps.
 /// - Origin: centre of the first edge (ascending: nosing of tread 1; descending: floor's edge).
 /// - Validation: riser, tread, 2R+T and width against the building code (a width cut by the image
 ///   border only against half the minimum), evenly spaced edges; a
-///   single level by size (obstacle / single step / curb, paper 4.1 last paragraph).
+///   single level by size (obstacle / single step / curb, paper 4.1 last paragraph); a level one
+///   riser below the floor starting at the shadow of the floor's edge is a drop however shallow.
 
 #include <Eigen/Core>
 #include <vector>
@@ -86,6 +89,8 @@ class StairModelling {
   std::vector<int> bin_count_;
   std::vector<char> landing_;         ///< per level: deeper than a tread (landing or floor)
   std::vector<char> outlier_;         ///< per level: edge off the staircase's line
+  std::vector<float> riser_at_;       ///< per level: position along z_S of the riser below it (NaN: none)
+  std::vector<int> riser_n_;          ///< per level: points of that riser's region
   const CameraIntrinsics* K_ = nullptr;  ///< intrinsics of the frame being modelled, when given
 };
 
