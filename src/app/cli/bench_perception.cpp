@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/bench_util.hpp"
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/capture/synthetic.hpp"
@@ -30,26 +31,6 @@
 
 namespace stairguide::cli {
 namespace {
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(i, v.size() - 1)];
-}
-
-double cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
-struct Timer {
-  std::chrono::steady_clock::time_point w = std::chrono::steady_clock::now();
-  double c = cpu_ms();
-  double wall() const { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w).count(); }
-  double cpu() const { return cpu_ms() - c; }
-};
 
 /// The paper's segmentation built from PCL classes; returns the planar regions (points only) and
 /// the number of clusters.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/bench_util.hpp"
 #include "cli/command.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/perception.hpp"
@@ -15,13 +16,6 @@
 
 namespace stairguide::cli {
 namespace {
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(i, v.size() - 1)];
-}
 
 std::vector<double> time_stage(StairStage& stage, const std::vector<SceneResult>& scenes, const CameraIntrinsics& K,
                                int repeat, int& detected) {

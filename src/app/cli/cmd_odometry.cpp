@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/bench_util.hpp"
 #include "cli/command.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
@@ -30,21 +31,6 @@
 
 namespace stairguide::cli {
 namespace {
-
-double cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
-struct Timer {
-  std::chrono::steady_clock::time_point w = std::chrono::steady_clock::now();
-  double c = cpu_ms();
-  double wall() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w).count();
-  }
-  double cpu() const { return cpu_ms() - c; }
-};
 
 /// OpenCV's RgbdOdometry with the same outer policy as ours (constant-velocity initial guess,
 /// held on failure). Its Rt maps points of the source (previous) frame into the destination
