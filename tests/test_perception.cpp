@@ -338,6 +338,9 @@ namespace {
 struct PresetFigures {
   int frames = 0, floor_visible = 0, floor_ok = 0, floor_wrong_plane = 0;
   int treads = 0, treads_ok = 0, mixed = 0, manhattan_checked = 0, manhattan_ok = 0;
+  // Tread failures by kind: no horizontal region at its height, or found with a normal, a
+  // height or a class out of bounds (one tread may fail several ways).
+  int tread_missed = 0, tread_bad_normal = 0, tread_bad_height = 0, tread_bad_class = 0;
   float worst_h = 0, worst_tilt = 0, worst_roll = 0, worst_n = 0, worst_H = 0, worst_yaw = 0;
   std::vector<double> cpu_ms;
 };
@@ -470,8 +473,18 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
           continue;  // the curb's level the user stands on: that is the floor, not a step
         ++F.treads;
         if (best < 0) {
+          ++F.tread_missed;
           std::printf("  %s #%llu: tread %d (%d px) not found\n", preset.c_str(),
                       static_cast<unsigned long long>(truth->index), k, st.visible_pixels[i]);
+          if (getenv("SG_DEBUG_TREADS")) {  // what lies at the tread's height instead
+            for (const PlaneRegion& R : sc.regions) {
+              const Eigen::Vector3f cs = T_sc * R.centroid;
+              if (std::fabs(cs.y() + by - Hs) > 0.15f) continue;
+              std::printf("    near: %d px n-err %.2f dy %.3f x %.2f z %.2f cls %s\n", R.pixel_count,
+                          std::acos(std::min(1.f, std::fabs(R.normal.dot(up)))) / kDeg, cs.y() + by - Hs, cs.x(),
+                          cs.z(), to_string(R.cls));
+            }
+          }
           continue;
         }
         const PlaneRegion& R = sc.regions[best];
@@ -482,6 +495,9 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
         F.worst_H = std::max(F.worst_H, eH);
         const bool ok = en <= 2.f && eH <= 0.01f && R.cls == RegionClass::kStepCandidate;
         F.treads_ok += ok;
+        F.tread_bad_normal += en > 2.f;
+        F.tread_bad_height += eH > 0.01f;
+        F.tread_bad_class += R.cls != RegionClass::kStepCandidate;
         if (!ok)
           std::printf("  %s #%llu: tread %d (%d px): region %d px n-err %.2f deg H %.3f vs %.3f cls %s\n",
                       preset.c_str(), static_cast<unsigned long long>(truth->index), k, st.visible_pixels[i],
@@ -527,10 +543,11 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
 
 void print(const std::string& name, const PresetFigures& F) {
   std::printf("%-28s frames %3d floor %d/%d (wrong plane %d) h %.3f tilt %.2f roll %.2f | treads %d/%d n %.2f H %.3f "
-              "mixed %d | manhattan %d/%d yaw %.2f | cpu median %.2f ms\n",
+              "(missed %d, normal %d, height %d, class %d) mixed %d | manhattan %d/%d yaw %.2f | cpu median %.2f ms\n",
               name.c_str(), F.frames, F.floor_ok, F.floor_visible, F.floor_wrong_plane, F.worst_h, F.worst_tilt,
-              F.worst_roll, F.treads_ok, F.treads, F.worst_n, F.worst_H, F.mixed, F.manhattan_ok,
-              F.manhattan_checked, F.worst_yaw, median(F.cpu_ms));
+              F.worst_roll, F.treads_ok, F.treads, F.worst_n, F.worst_H, F.tread_missed, F.tread_bad_normal,
+              F.tread_bad_height, F.tread_bad_class, F.mixed, F.manhattan_ok, F.manhattan_checked, F.worst_yaw,
+              median(F.cpu_ms));
 }
 
 }  // namespace
@@ -555,6 +572,10 @@ struct Totals {
     all.floor_wrong_plane += F.floor_wrong_plane;
     all.treads += F.treads;
     all.treads_ok += F.treads_ok;
+    all.tread_missed += F.tread_missed;
+    all.tread_bad_normal += F.tread_bad_normal;
+    all.tread_bad_height += F.tread_bad_height;
+    all.tread_bad_class += F.tread_bad_class;
     all.mixed += F.mixed;
     all.manhattan_checked += F.manhattan_checked;
     all.manhattan_ok += F.manhattan_ok;
@@ -569,11 +590,12 @@ class TotalsCheck : public ::testing::Environment {
     if (Totals::get().presets + Totals::sequences().presets < static_cast<int>(synth::presets().size())) return;  // filtered
     for (int k = 0; k < 2; ++k) {
       const PresetFigures& A = (k == 0 ? Totals::get() : Totals::sequences()).all;
-      std::printf("ALL %s: frames %d floor %d/%d (%.1f %%) wrong plane %d | treads %d/%d (%.1f %%) mixed %d | "
-                  "manhattan %d/%d\n",
+      std::printf("ALL %s: frames %d floor %d/%d (%.1f %%) wrong plane %d | treads %d/%d (%.1f %%) (missed %d, "
+                  "normal %d, height %d, class %d) mixed %d | manhattan %d/%d\n",
                   k == 0 ? "STATIC PRESETS" : "SEQUENCE WINDOWS", A.frames, A.floor_ok, A.floor_visible,
                   100.0 * A.floor_ok / std::max(1, A.floor_visible), A.floor_wrong_plane, A.treads_ok, A.treads,
-                  100.0 * A.treads_ok / std::max(1, A.treads), A.mixed, A.manhattan_ok, A.manhattan_checked);
+                  100.0 * A.treads_ok / std::max(1, A.treads), A.tread_missed, A.tread_bad_normal,
+                  A.tread_bad_height, A.tread_bad_class, A.mixed, A.manhattan_ok, A.manhattan_checked);
     }
     const PresetFigures& A = Totals::get().all;
     EXPECT_EQ(Totals::get().presets, statics);
@@ -582,6 +604,8 @@ class TotalsCheck : public ::testing::Environment {
     // Issue 3 asks 99 %; frames where a floor strip no wider than a staircase right ahead fills
     // the bottom of the view are ambiguous in one frame and report no floor (see FloorDetector).
     EXPECT_GE(A.floor_ok, 0.98 * A.floor_visible) << "floor found where it is visible";
+    // 485/537 (90.3 %) measured; 85.7 % before horizontal regions took the floor's normal.
+    EXPECT_GE(A.treads_ok, 0.9 * A.treads) << "treads found over all static presets";
   }
 };
 const auto* const kTotals = ::testing::AddGlobalTestEnvironment(new TotalsCheck);
@@ -619,7 +643,25 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     EXPECT_GE(F.floor_ok, 0.5 * F.floor_visible) << "floor found within 2 cm / 1 deg";
   }
   if (length <= 1) {
+    // Measured with the seeds above (treads ok / treads), held with one tread of slack. Horizontal
+    // regions take the floor's normal (classify_regions), so every tread found has a normal within
+    // the floor's error; what remains are treads with no region: parts the sensor model leaves
+    // without depth (projector shadows into a descent, the far end of a flight), slivers between
+    // people's legs or handrail posts, and far thin treads left unseeded.
+    static const std::map<std::string, std::pair<int, int>> measured = {
+        {"ascending_static", {51, 54}},     {"descending_static", {103, 110}},
+        {"open_risers_static", {50, 59}},   {"nosing_landing_static", {51, 55}},
+        {"rotated_static", {52, 62}},       {"people_static", {80, 99}},
+        {"handrails_open_sides_static", {38, 38}}, {"single_step_static", {15, 15}},
+        {"curb_static", {7, 7}},            {"ascending_short_static", {38, 38}}};
+    const auto it = measured.find(preset);
+    if (it != measured.end()) {
+      EXPECT_EQ(F.treads, it->second.second) << "visible treads (the synthetic world changed?)";
+      EXPECT_GE(F.treads_ok, it->second.first - 1) << "treads found with normal <= 2 deg, height <= 1 cm";
+    }
     EXPECT_GE(F.treads_ok, 0.7 * F.treads) << "treads found with normal <= 2 deg, height <= 1 cm";
+    EXPECT_EQ(F.tread_bad_normal, 0) << "a tread found with its normal more than 2 deg off";
+    EXPECT_EQ(F.tread_bad_class, 0) << "a tread found but not classed step candidate";
   }
 }
 

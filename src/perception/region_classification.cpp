@@ -23,6 +23,14 @@ void classify_regions(SceneResult& scene, const ClassificationConfig& cfg) {
     const Eigen::Vector3f nf = Rf * r.normal;
     r.height = (Rf * r.centroid + tf).y();
     if (std::fabs(nf.y()) >= cos_par) {
+      // A horizontal region is parallel to the floor: its own fit (few rows for a thin far tread,
+      // seen at a grazing angle) constrains the tilt poorly, while the floor's normal comes from a
+      // large, well-spread plane. Take the floor's normal and refit only the offset through the
+      // centroid (the least-squares offset for a fixed normal). Only regions already within
+      // parallel_threshold of horizontal are changed, so no class changes.
+      const float sgn = nf.y() > 0.f ? 1.f : -1.f;
+      r.normal = Rf.transpose() * Eigen::Vector3f(0.f, sgn, 0.f);
+      r.offset = -r.normal.dot(r.centroid);
       const float H = r.height;
       if (i == scene.floor_region || std::fabs(H) <= cfg.floor_height_tolerance) {
         r.cls = RegionClass::kFloor;
