@@ -1,5 +1,7 @@
 #include "stairguide/stairs/stair_eval.hpp"
 
+#include "stairguide/core/json.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -181,46 +183,30 @@ void StairEvalTable::add(const StairFrameEval& e, const std::string& scene) {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", std::isfinite(v) ? v : 0.0);
-  return b;
-}
-
-std::string quote(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    o += c;
-  }
-  return o + "\"";
-}
-
 std::string summary_json(const EvalSummary& s) {
   std::string o = "{";
   auto kv = [&](const char* k, const std::string& v) {
     if (o.size() > 1) o += ", ";
     o += std::string("\"") + k + "\": " + v;
   };
-  kv("frames", num(s.frames));
-  kv("tp", num(s.tp));
-  kv("fp", num(s.fp));
-  kv("tn", num(s.tn));
-  kv("fn", num(s.fn));
-  kv("skipped", num(s.skipped));
-  kv("precision", num(s.precision()));
-  kv("recall", num(s.recall()));
-  kv("kind_correct", num(s.kind_correct));
-  kv("recall_fully_visible", num(s.recall_fully_visible()));
-  kv("fully_visible_frames", num(s.full_tp + s.full_fn));
+  kv("frames", json_number(s.frames));
+  kv("tp", json_number(s.tp));
+  kv("fp", json_number(s.fp));
+  kv("tn", json_number(s.tn));
+  kv("fn", json_number(s.fn));
+  kv("skipped", json_number(s.skipped));
+  kv("precision", json_number(s.precision()));
+  kv("recall", json_number(s.recall()));
+  kv("kind_correct", json_number(s.kind_correct));
+  kv("recall_fully_visible", json_number(s.recall_fully_visible()));
+  kv("fully_visible_frames", json_number(s.full_tp + s.full_fn));
   auto stats = [&](const char* name, const ErrorStats& e, const char* unit) {
     const std::string p(name);
-    kv((p + "_err_n").c_str(), num(e.n));
-    kv((p + "_err_mean_" + unit).c_str(), num(e.mean_abs()));
-    kv((p + "_err_bias_" + unit).c_str(), num(e.mean()));
-    kv((p + "_err_sigma_" + unit).c_str(), num(e.sigma()));
-    kv((p + "_err_max_" + unit).c_str(), num(e.max_abs));
+    kv((p + "_err_n").c_str(), json_number(e.n));
+    kv((p + "_err_mean_" + unit).c_str(), json_number(e.mean_abs()));
+    kv((p + "_err_bias_" + unit).c_str(), json_number(e.mean()));
+    kv((p + "_err_sigma_" + unit).c_str(), json_number(e.sigma()));
+    kv((p + "_err_max_" + unit).c_str(), json_number(e.max_abs));
   };
   stats("riser", s.riser, "m");
   stats("tread", s.tread, "m");
@@ -242,7 +228,7 @@ std::string StairEvalTable::to_json() const {
     for (const auto& [k, v] : *group) {
       if (!first) o += ", ";
       first = false;
-      o += quote(k) + ": " + summary_json(v);
+      o += json_quote(k) + ": " + summary_json(v);
     }
     o += "}";
   }

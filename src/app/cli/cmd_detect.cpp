@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "stairguide/core/json.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_draw.hpp"
@@ -16,11 +17,8 @@
 namespace stairguide::cli {
 namespace {
 
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", std::isfinite(v) ? v : 0.0);
-  return b;
-}
+std::string fmt(double v) { return json_number(v); }
+const auto& quote = json_quote;
 
 std::string vec3(const Eigen::Vector3f& v) { return "[" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + "]"; }
 
@@ -30,16 +28,6 @@ std::string mat4(const Pose& T) {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) o += fmt(M(r, c)) + (r == 3 && c == 3 ? "]" : ", ");
   return o;
-}
-
-std::string quote(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    o += c;
-  }
-  return o + "\"";
 }
 
 int detect(Context& ctx) {
