@@ -468,9 +468,9 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
           if (best >= 0) break;
         }
         const float user_base_k = truth->camera_height_m - (T_sc * Eigen::Vector3f::Zero()).y() - by;
-        if (best >= 0 && st.kind == StairKind::kCurb &&
-            std::fabs(truth->camera_height_m - (T_sc * Eigen::Vector3f::Zero()).y() - by + Hs) < 0.05f)
-          continue;  // the curb's level the user stands on: that is the floor, not a step
+        // The level the user stands on (a curb's upper level, the landing reached at the top of a
+        // climb, the floor at the foot of a descent) is the floor, not a step.
+        if ((best >= 0 || st.kind != StairKind::kCurb) && std::fabs(user_base_k + Hs) < 0.05f) continue;
         ++F.treads;
         if (best < 0) {
           ++F.tread_missed;
