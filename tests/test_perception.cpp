@@ -601,9 +601,13 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(Totals::get().presets, statics);
     EXPECT_EQ(A.floor_wrong_plane, 0) << "never a tread or a table taken for the floor";
     EXPECT_EQ(Totals::sequences().all.floor_wrong_plane, 0) << "never a tread below the user taken for the floor";
-    // Issue 3 asks 99 %; frames where a floor strip no wider than a staircase right ahead fills
-    // the bottom of the view are ambiguous in one frame and report no floor (see FloorDetector).
-    EXPECT_GE(A.floor_ok, 0.98 * A.floor_visible) << "floor found where it is visible";
+    // Issue 3 asks 99 % (measured 424/428). The 4 misses are frames where a floor strip no deeper
+    // than a tread, with a tread-sized plane one riser above it, fills the bottom of the view: in
+    // one frame that is also what the first tread of a staircase looks like, and the detector says
+    // "no floor" rather than count one step too few (in use, tracking from earlier frames decides).
+    EXPECT_GE(A.floor_ok, 0.99 * A.floor_visible) << "floor found where it is visible";
+    EXPECT_EQ(Totals::sequences().all.floor_ok, Totals::sequences().all.floor_visible)
+        << "floor found where it is visible, walking sequences";
     // 485/537 (90.3 %) measured; 85.7 % before horizontal regions took the floor's normal.
     EXPECT_GE(A.treads_ok, 0.9 * A.treads) << "treads found over all static presets";
   }
@@ -638,9 +642,9 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
   // the treads and the landing below while the tread underfoot is out of view.
   EXPECT_EQ(F.floor_wrong_plane, 0) << "a tread, a seat or a platform taken for the floor";
   if (length > 1) {
-    // KNOWN GAPS (sequences): floor misses while the tread underfoot is out of view on the
-    // stairs and during the fast turn; tread figures on the stairs. Held as a regression bound.
-    EXPECT_GE(F.floor_ok, 0.5 * F.floor_visible) << "floor found within 2 cm / 1 deg";
+    // Walking: the floor is tracked, also at the top of a descent where the treads below are
+    // nearer the user's feet than the floor beside the stairwell (measured: every frame).
+    EXPECT_EQ(F.floor_ok, F.floor_visible) << "floor found within 2 cm / 1 deg";
   }
   if (length <= 1) {
     // Measured with the seeds above (treads ok / treads), held with one tread of slack. Horizontal

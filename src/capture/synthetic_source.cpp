@@ -88,6 +88,7 @@ class SyntheticSource final : public FrameSource {
   }
   CameraIntrinsics intrinsics() const override { return synthetic_intrinsics(options_); }
   long frame_count() const override { return frames_; }
+  bool independent_frames() const override { return !def_.sequence; }
   std::string describe() const override { return "synthetic " + def_.info.name; }
   std::optional<FrameTruth> truth() const override {
     if (!has_truth_) return std::nullopt;

@@ -130,6 +130,10 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
     if (static_cast<int>(j) == c) continue;
     const PlaneRegion& A = regions[j];
     if (A.area < 0.1f * cfg_.min_area || A.normal.dot(C.normal) < cos_par) continue;
+    // A level bigger than any tread or landing a riser from it is another floor level (a platform,
+    // the far side of a curb), as in the paper's single-candidate rule (4.1): the candidate at the
+    // view's edge is then the user's floor, not a tread before it.
+    if (A.area > cfg_.ambiguous_tread_area_max) continue;
     // One riser above (an ascending staircase from here) or below (a descending one: the user may
     // stand on a tread higher up, out of view, with this one its next but one).
     const float rise = std::fabs(C.offset - A.offset);
@@ -227,6 +231,17 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     const bool stair = clear && !tracked && stair_from_view_edge(regions, chosen, near, frame.depth.cols);
     if (clear && !stair) {
       est.tracked = tracked;
+      anchor_ = f.offset;
+      break;
+    }
+    // At the top of a descending staircase the treads below are nearer the user's feet than the
+    // floor seen beside the stairwell, so the check above fails although the user has not moved
+    // off the floor. The tracked floor is kept while the camera stays at the height last verified
+    // on a clear view: stepping down onto a tread lowers the camera by a riser (13 cm or more),
+    // far more than the tolerance, and then the check applies again.
+    if (tracked && anchor_ && cfg_.track_anchor_tolerance > 0.f &&
+        std::fabs(f.offset - *anchor_) <= cfg_.track_anchor_tolerance) {
+      est.tracked = true;
       break;
     }
     if (!clear) ++rejected_below;
@@ -266,7 +281,10 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
 }
 
 FloorEstimate& FloorDetector::lost(FloorEstimate& est) {
-  if (prev_ && ++lost_frames_ >= std::max(cfg_.track_hold_frames, cfg_.track_forget_frames)) prev_.reset();
+  if (prev_ && ++lost_frames_ >= std::max(cfg_.track_hold_frames, cfg_.track_forget_frames)) {
+    prev_.reset();
+    anchor_.reset();
+  }
   return est;
 }
 

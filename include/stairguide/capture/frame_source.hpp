@@ -54,6 +54,10 @@ class FrameSource {
 
   /// True for a live device (pacing comes from the device, reconnection makes sense).
   virtual bool is_live() const { return false; }
+
+  /// True when consecutive frames are unrelated views (a static synthetic preset draws a new scene
+  /// for every index): tracking from one frame to the next means nothing there.
+  virtual bool independent_frames() const { return false; }
 };
 
 /// Opens an input by name: a directory is a dataset folder, a path ending in .oni an OpenNI2

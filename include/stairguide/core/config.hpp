@@ -116,13 +116,15 @@ struct FloorConfig {
   float horizontal_tolerance = 0.17453293f;  ///< rad, floor candidates vs the tracked floor normal (10 deg)
   int track_hold_frames = 15;     ///< frames the tracked floor is held after it was last seen
   int track_forget_frames = 300;  ///< frames the user's camera height is remembered after the floor was last seen
+  float track_anchor_tolerance = 0.04f;  ///< m, a tracked floor this near the last verified camera height needs no re-verification
   float verify_drop = 0.06f;      ///< m, a point this far below a floor candidate counts as "below"
-  float verify_margin_angle = 0.0087266f;  ///< rad, "nearer the user": this much nearer the nadir than the candidate's near edge (0.5 deg)
+  float verify_margin_angle = 0.0087266463f;  ///< rad, "nearer the user": this much nearer the nadir than the candidate's near edge (0.5 deg)
   float view_edge_angle = 0.034906585f;    ///< rad, a plane within this of the view's bottom edge "starts at the edge" (2 deg)
   float ambiguous_rise_min = 0.10f;  ///< m, a plane this much above a candidate starting at the view's edge ...
   float ambiguous_rise_max = 0.22f;  ///< m, ... and at most this ...
   float ambiguous_depth_max = 0.45f; ///< m, ... and starting within this of its near edge: the candidate may be a tread
   float ambiguous_covered = 0.9f;    ///< share of such a candidate's pixels with the upper plane above them in the image
+  float ambiguous_tread_area_max = 2.0f;  ///< m^2, a plane bigger than this is a floor level, never the tread after the candidate
   int verify_min_pixels = 400;    ///< px, this many pixels below and nearer reject a floor candidate
   int verify_stride_px = 6;       ///< px, sampling grid of the frame for the check
 
@@ -148,6 +150,9 @@ struct FloorConfig {
     v.num(track_forget_frames, "track_forget_frames", Unit::kCount, 0, 100000,
           "frames the camera height above the floor is remembered after the floor was last seen: meanwhile a "
           "plane a riser or more lower (a tread below the user) is never taken for the floor");
+    v.num(track_anchor_tolerance, "track_anchor_tolerance_cm", Unit::kCentimetre, 0, 20,
+          "a tracked floor within this of the camera height last verified from a clear view is kept even when "
+          "lower planes lie nearer the user (the user at the top of a descending staircase); 0 turns it off");
     v.num(verify_drop, "verify_drop_cm", Unit::kCentimetre, 1, 100,
           "floor check: a point this far below a candidate counts as below it");
     v.num(verify_margin_angle, "verify_margin_deg", Unit::kDegree, 0, 30,
@@ -161,6 +166,8 @@ struct FloorConfig {
           "... starting within this of its near edge may be a tread: not taken as the floor");
     v.num(ambiguous_covered, "ambiguous_covered_percent", Unit::kPercent, 0, 100,
           "... when this share of its pixels has the upper plane above them in the image");
+    v.num(ambiguous_tread_area_max, "ambiguous_tread_area_max_m2", Unit::kNone, 0.1, 100,
+          "... unless that plane is bigger than this, square metres (no tread or landing is: another floor level)");
     v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,
           "floor check: this many pixels below a candidate and nearer the user reject it (a step or seat seen from in front)");
     v.num(verify_stride_px, "verify_stride_px", Unit::kPixel, 1, 32, "floor check: sampling grid of the frame");
@@ -280,11 +287,11 @@ struct OdometryConfig {
   int max_points_per_level = 20000; ///< pixels per pyramid level (a level with more is subsampled on a grid)
   float max_inv_depth_step = 0.05f; ///< fraction of W between neighbouring full-res pixels = depth edge
   float min_update_translation = 1e-4f;  ///< m, an update below this (and the rotation one) = converged
-  float min_update_rotation = 1.745e-4f; ///< rad (0.01 deg)
+  float min_update_rotation = 1.7453293e-4f; ///< rad (0.01 deg)
   float min_inlier_fraction = 0.5f; ///< share of used pixels with both residuals within 3 sigma
   bool adaptive_scale = true;       ///< weight scales follow the residuals while above sigma_I / sigma_W
   float keyframe_max_translation = 0.10f; ///< m from the reference frame beyond which the current frame becomes it (0: frame to frame)
-  float keyframe_max_rotation = 0.1047f;  ///< rad from the reference frame beyond which the current frame becomes it
+  float keyframe_max_rotation = 0.10471976f; ///< rad from the reference frame beyond which the current frame becomes it
   float keyframe_min_overlap = 0.6f;      ///< share of the reference's finest-level points still matched, below which a new reference is taken
 
   template <class V> void visit(V& v) {

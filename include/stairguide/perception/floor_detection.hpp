@@ -64,6 +64,7 @@ class FloorDetector {
   /// Forgets the tracked floor (a new sequence).
   void reset() {
     prev_.reset();
+    anchor_.reset();
     lost_frames_ = 0;
   }
   const FloorConfig& config() const { return cfg_; }
@@ -92,6 +93,9 @@ class FloorDetector {
     float offset;
   };
   std::optional<Prev> prev_;
+  // Camera height above the floor, last measured on a floor that passed every check (nothing lower
+  // nearer the user, not a possible tread). Forgotten with prev_.
+  std::optional<float> anchor_;
   std::vector<float> window_area_;
 };
 

@@ -46,10 +46,11 @@ int analyze(Context& ctx) {
     return 1;
   }
   // Frames before N go through perception too, so that the floor and Manhattan tracking see the
-  // same history as in a live run.
+  // same history as in a live run; unless the source's frames are unrelated views.
   Perception perception(ctx.config);
   RgbdFrame frame;
   SceneResult scene;
+  const bool independent = source->independent_frames();
   for (long i = 0; i <= index; ++i) {
     const ReadResult r = source->read(frame);
     if (!r.ok()) {
@@ -57,7 +58,7 @@ int analyze(Context& ctx) {
                    r.message.empty() ? "end of input" : r.message.c_str());
       return 1;
     }
-    perception.process(frame, scene);
+    if (!independent || i == index) perception.process(frame, scene);
   }
   const Eigen::Matrix3f Rf = scene.T_floor_camera.linear();
   if (json) {
