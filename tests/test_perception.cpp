@@ -608,8 +608,10 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_GE(A.floor_ok, 0.99 * A.floor_visible) << "floor found where it is visible";
     EXPECT_EQ(Totals::sequences().all.floor_ok, Totals::sequences().all.floor_visible)
         << "floor found where it is visible, walking sequences";
-    // 485/537 (90.3 %) measured; 85.7 % before horizontal regions took the floor's normal.
-    EXPECT_GE(A.treads_ok, 0.9 * A.treads) << "treads found over all static presets";
+    // 498/502 (99.2 %) measured (treads with >= 200 pixels that keep a depth reading); 485/537
+    // before thin strips were seeded on dominant directions and before the truth left out tread
+    // pixels the sensor gives no depth for (grazing incidence, mixed pixels behind nosings).
+    EXPECT_GE(A.treads_ok, 0.99 * A.treads) << "treads found over all static presets";
   }
 };
 const auto* const kTotals = ::testing::AddGlobalTestEnvironment(new TotalsCheck);
@@ -649,21 +651,22 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
   if (length <= 1) {
     // Measured with the seeds above (treads ok / treads), held with one tread of slack. Horizontal
     // regions take the floor's normal (classify_regions), so every tread found has a normal within
-    // the floor's error; what remains are treads with no region: parts the sensor model leaves
-    // without depth (projector shadows into a descent, the far end of a flight), slivers between
-    // people's legs or handrail posts, and far thin treads left unseeded.
+    // the floor's error. The four misses: tread slivers one to five rows tall at the top of the
+    // image, or behind a protruding nosing, taken into the riser below them (rotated #0,
+    // people #3, nosing_landing #11), and descending #23's lower floor, found but wider than the
+    // staircase (its centroid lies outside the flight).
     static const std::map<std::string, std::pair<int, int>> measured = {
-        {"ascending_static", {51, 54}},     {"descending_static", {103, 110}},
-        {"open_risers_static", {50, 59}},   {"nosing_landing_static", {51, 55}},
-        {"rotated_static", {52, 62}},       {"people_static", {80, 99}},
-        {"handrails_open_sides_static", {38, 38}}, {"single_step_static", {15, 15}},
+        {"ascending_static", {51, 51}},     {"descending_static", {105, 106}},
+        {"open_risers_static", {51, 51}},   {"nosing_landing_static", {51, 52}},
+        {"rotated_static", {52, 53}},       {"people_static", {89, 90}},
+        {"handrails_open_sides_static", {38, 38}}, {"single_step_static", {16, 16}},
         {"curb_static", {7, 7}},            {"ascending_short_static", {38, 38}}};
     const auto it = measured.find(preset);
     if (it != measured.end()) {
       EXPECT_EQ(F.treads, it->second.second) << "visible treads (the synthetic world changed?)";
       EXPECT_GE(F.treads_ok, it->second.first - 1) << "treads found with normal <= 2 deg, height <= 1 cm";
     }
-    EXPECT_GE(F.treads_ok, 0.7 * F.treads) << "treads found with normal <= 2 deg, height <= 1 cm";
+    EXPECT_GE(F.treads_ok, 0.95 * F.treads) << "treads found with normal <= 2 deg, height <= 1 cm";
     EXPECT_EQ(F.tread_bad_normal, 0) << "a tread found with its normal more than 2 deg off";
     EXPECT_EQ(F.tread_bad_class, 0) << "a tread found but not classed step candidate";
   }

@@ -1,5 +1,5 @@
 // Ground truth of a rendered frame, read off the renderer's per-pixel face ids so that "visible"
-// means what the camera actually sees (occluders and the sensor's range included).
+// means what the camera actually sees (occluders, the sensor's range and its holes included).
 #include <algorithm>
 #include <cmath>
 
@@ -55,16 +55,26 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
       face_slot[f] = slot_base[static_cast<std::size_t>(fc.stair)] + fc.tread;
     if (fc.normal.z() > 0.99f && std::abs(fc.vertices[0].z() - walker.support_z) < 0.01f) face_floor[f] = 1;
   }
+  // A tread pixel counts as visible only where the depth sensor gives a reading: a far tread
+  // seen beyond the grazing-incidence limit, or a strip lost to mixed pixels behind a nosing,
+  // shows in the ideal render but not to a depth camera. The sensor model's own hole rules
+  // decide (range, grazing incidence, depth jumps, projector shadows); its random dropout is
+  // left out (no seed here, and a 0.2 % dropout does not hide a tread).
+  SynthOptions sensed_o = o;
+  sensed_o.dropout = 0.f;
+  cv::Mat sensed;
+  apply_depth_sensor(ideal, K, sensed_o, 1u, sensed);
   std::vector<int> counts(static_cast<std::size_t>(slot_base.back()), 0);
   long floor_pixels = 0;
   for (int v = 0; v < ideal.face.rows; ++v) {
     const int* fr = ideal.face.ptr<int>(v);
     const float* zr = ideal.depth.ptr<float>(v);
+    const float* sr = sensed.ptr<float>(v);
     for (int u = 0; u < ideal.face.cols; ++u) {
       const int f = fr[u];
       if (f < 0 || zr[u] < o.min_range_m || zr[u] > o.max_range_m) continue;
       const int slot = face_slot[static_cast<std::size_t>(f)];
-      if (slot >= 0) ++counts[static_cast<std::size_t>(slot)];
+      if (slot >= 0 && sr[u] > 0.f) ++counts[static_cast<std::size_t>(slot)];
       floor_pixels += face_floor[static_cast<std::size_t>(f)];
     }
   }

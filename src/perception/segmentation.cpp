@@ -65,7 +65,89 @@ PlaneFit fit_plane(const InvDepthMoments& m) {
   return f;
 }
 
+PlaneFit fit_plane_fixed_normal(const InvDepthMoments& m, const Eigen::Vector3f& n) {
+  PlaneFit f;
+  if (m.n < 1.0) return f;
+  // With n fixed the plane is 1/z = g s, s = -(n . (u', v', 1)), g = 1/d: one unknown.
+  const double nx = n.x(), ny = n.y(), nz = n.z();
+  const double ssw = -(nx * m.suw + ny * m.svw + nz * m.sw);
+  const double sss = nx * nx * m.suu + ny * ny * m.svv + nz * nz * m.n + 2.0 * nx * ny * m.suv + 2.0 * nx * nz * m.su +
+                     2.0 * ny * nz * m.sv;
+  if (!(sss > 1e-30)) return f;
+  const double g = ssw / sss;
+  if (!(g > 1e-9)) return f;  // the points would lie behind the camera on such a plane
+  f.ok = true;
+  f.d = static_cast<float>(1.0 / g);
+  f.normal = n;
+  f.a = static_cast<float>(-g * nx);
+  f.b = static_cast<float>(-g * ny);
+  f.c = static_cast<float>(-g * nz);
+  f.rms_w = static_cast<float>(std::sqrt(std::max(0.0, (m.sww - g * ssw) / m.n)));
+  const double in = 1.0 / m.n, mu = m.su * in, mv = m.sv * in;
+  const double wm = f.a * mu + f.b * mv + f.c;
+  if (wm > 1e-9) f.mean = Eigen::Vector3f(static_cast<float>(mu / wm), static_cast<float>(mv / wm), static_cast<float>(1.0 / wm));
+  return f;
+}
+
 Segmentation::Segmentation(const SegmentationConfig& config) : cfg_(config) {}
+
+void Segmentation::find_dominant_directions(const std::vector<Grow>& grows) {
+  // Normals of the big regions of the cell pass, biggest first; one per direction (a tread and
+  // the floor give one). Their fits span hundreds of rows, so their tilt is the precise one.
+  dirs_.clear();
+  const double min_px = std::max<double>(cfg_.region_min_pixels, cfg_.dominant_min_fraction * stats_.valid_pixels);
+  std::vector<int>& idx = sorted_;
+  idx.clear();
+  for (int r = 0; r < static_cast<int>(grows.size()); ++r)
+    if (grows[r].count >= min_px && grows[r].plane.ok) idx.push_back(r);
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) { return grows[a].count > grows[b].count; });
+  const float same = std::cos(3.f * 3.14159265f / 180.f);
+  for (int r : idx) {
+    const Eigen::Vector3f& n = grows[r].plane.normal;
+    bool dup = false;
+    for (const Eigen::Vector3f& d : dirs_) dup |= d.dot(n) > same;
+    if (!dup) dirs_.push_back(n);
+    if (dirs_.size() >= 8) break;
+  }
+  stats_.dominant_directions = static_cast<int>(dirs_.size());
+}
+
+int Segmentation::best_direction(const InvDepthMoments& m, PlaneFit& fit) const {
+  // A few rows cannot tell directions that differ by a tilt about the image rows: several may
+  // fit within the noise, and the lowest residual among them is chance. The direction with the
+  // most support (dirs_ is ordered by region size: the floor first) is the likelier one.
+  const float limit = 0.5f * tolerance_w();
+  for (int i = 0; i < static_cast<int>(dirs_.size()); ++i) {
+    const PlaneFit f = fit_plane_fixed_normal(m, dirs_[i]);
+    if (!f.ok || f.rms_w > limit) continue;
+    fit = f;
+    return i;
+  }
+  return -1;
+}
+
+PlaneFit Segmentation::region_plane(const InvDepthMoments& m, int& dir) const {
+  const PlaneFit free = fit_plane(m);
+  if (dir < 0 || dir >= static_cast<int>(dirs_.size())) {
+    dir = -1;
+    return free;
+  }
+  const PlaneFit fixed = fit_plane_fixed_normal(m, dirs_[dir]);
+  // Only regions wider than tall (in pixels) take a direction: their tilt is what a few rows
+  // leave open, and far treads, curbs and tread slivers at the image border are such strips
+  // (the camera's roll is small). A tall, narrow region (a post, a leg, a door frame) leaves its
+  // yaw open instead, and a borrowed yaw would mislead the Manhattan frame.
+  const double in = 1.0 / m.n;
+  const double su2 = (m.suu * in - (m.su * in) * (m.su * in)) * double(K_.fx) * K_.fx;
+  const double sv2 = (m.svv * in - (m.sv * in) * (m.sv * in)) * double(K_.fy) * K_.fy;
+  // Two more parameters always lower the residual a little; the fixed normal stays while the
+  // free fit is not clearly better (the region is parallel to the direction within the noise).
+  if (fixed.ok && sv2 <= su2 &&
+      (!free.ok || fixed.rms_w <= 1.1f * free.rms_w + 0.1f * cfg_.depth_noise_coeff))
+    return fixed;
+  dir = -1;
+  return free;
+}
 
 void Segmentation::backproject(const RgbdFrame& frame) {
   K_ = frame.intrinsics;
@@ -99,7 +181,7 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   stats_.valid_pixels = valid;
 }
 
-void Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, Grow& g) {
+bool Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, Grow& g) {
   int head = 0, tail = 0;
   for (int p : seed_pixels) {
     label_[p] = region;
@@ -108,7 +190,7 @@ void Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, 
     g.m.add(un_[u], vn_[v], w_[p]);
   }
   g.count = tail;
-  PlaneFit f = fit_plane(g.m);
+  PlaneFit f = g.dir >= 0 ? fit_plane_fixed_normal(g.m, dirs_[g.dir]) : fit_plane(g.m);
   if (f.ok) g.plane = f;
   int fit_count = g.count;
   float a = g.plane.a, b = g.plane.b, c = g.plane.c;
@@ -143,7 +225,7 @@ void Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, 
       if (++g.count >= 2 * fit_count) {
         // Refit whenever the region doubled: the seed cell's plane is rough at range, the grown
         // region's is not, and doubling keeps the refits O(log n).
-        const PlaneFit nf = fit_plane(g.m);
+        const PlaneFit nf = g.dir >= 0 ? fit_plane_fixed_normal(g.m, dirs_[g.dir]) : fit_plane(g.m);
         if (nf.ok) {
           g.plane = nf;
           a = nf.a, b = nf.b, c = nf.c;
@@ -152,15 +234,19 @@ void Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, 
       }
     }
   }
-  const PlaneFit nf = fit_plane(g.m);
+  const int dir = g.dir;
+  const PlaneFit nf = region_plane(g.m, g.dir);
   if (nf.ok) g.plane = nf;
-  if (g.count < cfg_.region_min_pixels) {
-    // Too small to be a region: give its pixels back for later seeds and for clustering.
+  if (g.count < cfg_.region_min_pixels || (dir >= 0 && g.dir < 0)) {
+    // Too small to be a region, or grown on a dominant direction its pixels reject: give its
+    // pixels back for later seeds and for clustering.
     for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
     g.count = 0;
     g.m = {};
     ++stats_.regions_dropped;
+    return dir >= 0 && g.dir < 0;
   }
+  return false;
 }
 
 void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
@@ -214,13 +300,75 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
     const PlaneFit f = fit_plane(m);
     if (!f.ok) continue;
     Grow g;
-    g.plane = f;
+    // A small cell's own tilt is rough at range (and a thin strip cut by the image border gives
+    // no better): grow on a dominant direction when the cell lies on one within the noise.
+    PlaneFit fc;
+    g.dir = best_direction(m, fc);
+    g.plane = g.dir >= 0 ? fc : f;
+    ++stats_.seeds_used;
+    if (grow_region(static_cast<int>(grows.size()), seed_pixels_, g)) {
+      // Its pixels reject the direction: the seed's own plane, then.
+      g = Grow{};
+      g.plane = f;
+      grow_region(static_cast<int>(grows.size()), seed_pixels_, g);
+    }
+    // Dropped regions stay as empty slots: ids are stable.
+    grows.push_back(g);
+  }
+}
+
+void Segmentation::strip_pass(std::vector<Grow>& grows) {
+  // Far treads seen from above, and treads cut by the image border, are strips of 2-3 rows: no
+  // square cell fits in them. A window of two rows fixes a plane's offset but not its tilt, so
+  // only dominant directions are tried here (one unknown, tested against 2 * len pixels).
+  const int len = cfg_.strip_length_px;
+  if (len < 2 || dirs_.empty()) return;
+  cells_.clear();
+  const int need = (2 * len * 3) / 4, need_row = len / 2;
+  const int cs = std::max(2, cfg_.cell_size_px);
+  const float limit = 0.5f * tolerance_w();
+  auto gather = [&](int u0, int v0, InvDepthMoments& m, std::vector<int>* pix) {
+    int rows_ok = 0;
+    for (int v = v0; v < v0 + 2; ++v) {
+      int cnt = 0;
+      const int row = v * W_;
+      for (int u = u0; u < u0 + len; ++u) {
+        const int p = row + u;
+        if (label_[p] != -1 || z_[p] <= 0.f) continue;
+        m.add(un_[u], vn_[v], w_[p]);
+        if (pix) pix->push_back(p);
+        ++cnt;
+      }
+      rows_ok += cnt >= need_row;
+    }
+    return rows_ok == 2 && m.n >= need;
+  };
+  for (int v0 = 0; v0 + 2 <= H_; ++v0) {
+    const int cv0 = v0 / cs, cv1 = (v0 + 1) / cs;
+    for (int u0 = 0; u0 + len <= W_; u0 += len) {
+      // Windows inside coarse cells that joined a region have no free pixel left.
+      const int cu0 = u0 / cs, cu1 = (u0 + len - 1) / cs;
+      if (cu0 == cu1 && cu0 < CW_ && cv1 < CH_ && cell_label_[static_cast<std::size_t>(cv0 * CW_ + cu0)] >= 0 &&
+          cell_label_[static_cast<std::size_t>(cv1 * CW_ + cu0)] >= 0)
+        continue;
+      InvDepthMoments m;
+      if (!gather(u0, v0, m, nullptr)) continue;
+      PlaneFit fc;
+      if (best_direction(m, fc) < 0) continue;
+      cells_.push_back({u0, v0, fc.rms_w / limit + fc.mean.z()});
+    }
+  }
+  std::sort(cells_.begin(), cells_.end(), [](const Cell& a, const Cell& b) { return a.score < b.score; });
+  for (const Cell& c : cells_) {
+    InvDepthMoments m;
+    seed_pixels_.clear();
+    if (!gather(c.u0, c.v0, m, &seed_pixels_)) continue;
+    Grow g;
+    g.dir = best_direction(m, g.plane);
+    if (g.dir < 0) continue;
     ++stats_.seeds_used;
     grow_region(static_cast<int>(grows.size()), seed_pixels_, g);
     grows.push_back(g);
-    if (g.count == 0) {
-      // Keep ids stable: a dropped region stays as an empty slot.
-    }
   }
 }
 
@@ -448,13 +596,17 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
       if (std::fabs(ra_b) > tolerance_w() || std::fabs(rb_a) > tolerance_w()) continue;
       InvDepthMoments m = grows[ra].m;
       m.add(grows[rb].m);
-      const PlaneFit f = fit_plane(m);
+      // A part grown on a dominant direction keeps it while the union does not reject it.
+      int dir = grows[ra].dir;
+      if (grows[rb].dir >= 0 && (dir < 0 || grows[rb].count > grows[ra].count)) dir = grows[rb].dir;
+      const PlaneFit f = region_plane(m, dir);
       if (!f.ok) continue;
       // One plane must explain both parts about as well as each part's own plane does.
       if (f.rms_w > 1.25f * std::max(pa.rms_w, pb.rms_w) + 0.25f * cfg_.depth_noise_coeff) continue;
       parent[rb] = ra;
       grows[ra].m = m;
       grows[ra].plane = f;
+      grows[ra].dir = dir;
       grows[ra].count += grows[rb].count;
       grows[rb].count = 0;
       ++stats_.regions_merged;
@@ -548,11 +700,13 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
   for (int r = 0; r < n; ++r) {
     Grow& g = grows[r];
     if (g.count < cfg_.region_min_pixels) continue;
-    const PlaneFit f = fit_plane(g.m);
+    // Border refinement moved pixels: the direction is checked again on the final moments.
+    const PlaneFit f = region_plane(g.m, g.dir);
     if (!f.ok || f.rms_w > 0.6f * tolerance_w()) {
       ++stats_.regions_dropped;
       continue;
     }
+    stats_.fixed_normal_regions += g.dir >= 0;
     fits_[out] = f;
     map[r] = static_cast<int>(out++);
   }
@@ -753,8 +907,10 @@ bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions
   }
   grows_.clear();
   cell_pass(grows_);
+  find_dominant_directions(grows_);
   if (cfg_.fine_cell_size_px > 1 && cfg_.fine_cell_size_px < cfg_.cell_size_px)
     seed_pass(cfg_.fine_cell_size_px, grows_);
+  strip_pass(grows_);
   stats_.grow_ms = lap();
   merge_regions(grows_);
   stats_.merge_ms = lap();

@@ -72,7 +72,9 @@ PresetFrame build_preset_frame(const std::string& preset, long index, std::uint3
 ///  - camera_height_m: camera height above the tread/floor under the user's body (walker.support_z);
 ///  - floor_visible: >= 5% of the pixels see, within the sensor's range, an upward surface at that height;
 ///  - per staircase: T_camera_stair; visible_steps: treads 1..steps (tread `steps` = the landing or
-///    floor after the last riser) with >= 200 pixels within range; first_edge_visible: an unoccluded
+///    floor after the last riser) with >= 200 pixels within range that keep a depth reading under the
+///    sensor model (its holes at grazing incidence, depth jumps and shadows; not its random dropout),
+///    visible_pixels their counts; first_edge_visible: an unoccluded
 ///    stretch of at least min(0.5 m, half the width) of the first edge is in view and in range (an
 ///    edge point is seen when a pixel of its 3x3 neighbourhood has its depth within 1 cm + 1%);
 ///    both_ends_visible: both ends (2-3 cm inside) are seen; user_step: tread under the body.

@@ -74,6 +74,8 @@ struct SegmentationConfig {
   int region_min_pixels = 100;       ///< px, smallest planar region kept
   int cluster_min_pixels = 200;      ///< px, smallest obstacle cluster kept
   int points_stride_px = 2;          ///< px, PlaneRegion::points keeps every Nth pixel in u and v
+  float dominant_min_fraction = 0.01f;  ///< share of the valid pixels a region needs for its normal to be a dominant direction
+  int strip_length_px = 8;           ///< px, columns of the 2-row windows seeding thin strips on dominant directions (0: off)
 
   template <class V> void visit(V& v) {
     v.num(voxel_size, "voxel_size_cm", Unit::kCentimetre, 0.5, 20, "voxel grid edge (paper: 3-4 cm)");
@@ -97,6 +99,10 @@ struct SegmentationConfig {
     v.num(cluster_min_pixels, "cluster_min_pixels", Unit::kPixel, 10, 1000000, "smallest obstacle cluster, pixels");
     v.num(points_stride_px, "points_stride_px", Unit::kPixel, 1, 16,
           "region point lists keep every Nth pixel in both directions");
+    v.num(dominant_min_fraction, "dominant_min_percent", Unit::kPercent, 0.01, 50,
+          "share of the valid pixels a region needs for its normal to be a dominant direction");
+    v.num(strip_length_px, "strip_length_px", Unit::kPixel, 0, 64,
+          "columns of the 2-row windows that seed thin strips (far treads) on a dominant direction; 0 = off");
   }
 };
 

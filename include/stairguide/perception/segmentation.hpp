@@ -11,7 +11,14 @@
 ///  3. pixels of the non-planar cells beside regions (edges, holes) join the neighbouring region
 ///     whose plane fits them best;
 ///  4. what is left is seeded again from `fine_cell_size_px` cells and grown pixel by pixel with a
-///     plane test and a local-continuity test (thin, far treads; stops at occlusion edges);
+///     plane test and a local-continuity test (thin, far treads; stops at occlusion edges); then
+///     from 2-row windows of `strip_length_px` columns (treads seen as strips 2-3 rows tall).
+///     A strip of a few rows fixes a plane's offset well but its tilt poorly (degrees at 3 m), so
+///     these seeds first try the dominant directions (normals of the regions covering at least
+///     `dominant_min_fraction` of the image: floor, walls, near treads and risers): a seed that
+///     lies on a plane parallel to one, within the noise, grows with that normal fixed and only
+///     its offset fitted; it keeps the fixed normal only while its pixels do not reject it (its
+///     free fit is not clearly better);
 ///  5. adjacent regions on one plane are merged; border pixels go to the plane that fits them best;
 ///     regions whose residual is not noise-like are dropped; area (pixel footprints on the plane),
 ///     principal rectangle, extent and curvature are computed;
@@ -78,6 +85,9 @@ struct PlaneFit {
 };
 /// Least-squares plane in inverse depth (see InvDepthMoments).
 PlaneFit fit_plane(const InvDepthMoments& m);
+/// Least-squares plane in inverse depth with its unit normal fixed to `n` (facing the camera):
+/// only the offset is fitted. Fails when the points lie behind the camera for that normal.
+PlaneFit fit_plane_fixed_normal(const InvDepthMoments& m, const Eigen::Vector3f& n);
 /// PCA plane of 3D points (principal axes, curvature).
 PlaneFit fit_plane_pca(const PointMoments& m);
 
@@ -91,6 +101,8 @@ struct SegmentationStats {
   /// Milliseconds per step (for `stairguide bench perception`).
   double backproject_ms = 0, grow_ms = 0, merge_ms = 0, refine_ms = 0, finalize_ms = 0, clusters_ms = 0;
   int regions_dropped = 0;  ///< grown regions below region_min_pixels or failing the planarity check
+  int dominant_directions = 0;  ///< normals the thin-strip seeds may take
+  int fixed_normal_regions = 0;  ///< regions grown with a dominant direction's normal
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -115,11 +127,20 @@ class Segmentation {
     PlaneFit plane;
     double fit_w = 0;
     int count = 0;
+    int dir = -1;  ///< index into dirs_ when the normal is fixed to a dominant direction
   };
   void backproject(const RgbdFrame& frame);
   void cell_pass(std::vector<Grow>& grows);
   void seed_pass(int cell, std::vector<Grow>& grows);
-  void grow_region(int region, const std::vector<int>& seed_pixels, Grow& g);
+  /// Grows a region from `seed_pixels` (g.plane, g.dir set). Returns true when the region was
+  /// grown with a fixed normal its pixels reject (it is then released, g.count == 0).
+  bool grow_region(int region, const std::vector<int>& seed_pixels, Grow& g);
+  void find_dominant_directions(const std::vector<Grow>& grows);
+  /// Best fixed-normal fit of `m` over the dominant directions within the planar-cell limit (-1: none).
+  int best_direction(const InvDepthMoments& m, PlaneFit& fit) const;
+  /// Plane of a region's moments: fixed to its dominant direction while the pixels accept it.
+  PlaneFit region_plane(const InvDepthMoments& m, int& dir) const;
+  void strip_pass(std::vector<Grow>& grows);
   void merge_regions(std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
   void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
@@ -163,6 +184,7 @@ class Segmentation {
   std::vector<std::uint8_t> cell_planar_;
   std::vector<int> order_, offsets_, sorted_;
   std::vector<std::uint8_t> mask_;
+  std::vector<Eigen::Vector3f> dirs_;  // dominant directions (unit normals facing the camera)
   SegmentationStats stats_;
 };
 
