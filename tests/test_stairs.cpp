@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
+#include "stairguide/capture/dataset.hpp"
+#include "stairguide/capture/frame_source.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "test_stairs_scene.hpp"
 
@@ -242,11 +247,21 @@ TEST(StairsUnit, NoFloorNoStairs) {
   StairSpec s;
   b.add_stairs(s);
   b.scene.floor_found = false;
-  StairStage stage(cfg());
+  // With the floorless route off, no floor means no heights and no staircase.
+  PipelineConfig c = cfg();
+  c.stair_detection.floorless = false;
+  StairStage stage(c);
   StairResult r;
   stage.run(b.scene, r);
   EXPECT_FALSE(r.detected);
   EXPECT_EQ(r.verdict, StairVerdict::kNoFloor);
+  // With it on, the stack of treads is found without a floor and says so
+  // (tests/test_stairs_floorless.cpp holds the figures).
+  c.stair_detection.floorless = true;
+  StairStage floorless(c);
+  floorless.run(b.scene, r);
+  EXPECT_TRUE(r.detected) << to_string(r.verdict);
+  EXPECT_TRUE(r.without_floor);
 }
 
 TEST(StairsUnit, FirstStepMustTouchTheFloor) {
@@ -353,6 +368,161 @@ TEST(StairsUnit, AccuracyOverManyRandomStaircases) {
   EXPECT_LT(tread / detected, 0.008);
   EXPECT_LT(origin / detected, 0.02);
   EXPECT_LT(yaw / detected, 1.0);
+}
+
+
+// ---- evaluation: which way a curb goes, and the kind as the user needs it ----
+
+/// A frame whose one stair (kind, direction) has its first edge 1.5 m ahead, one tread in view.
+FrameTruth one_level_truth(StairKind kind, bool down) {
+  FrameTruth f;
+  f.scene = "unit";
+  f.camera_height_m = 1.3f;
+  StairTruth s;
+  s.kind = kind;
+  s.down = down;
+  s.steps = kind == StairKind::kAscending || kind == StairKind::kDescending ? 5 : 1;
+  s.riser_m = 0.15f;
+  s.tread_m = 0.3f;
+  s.width_m = 1.2f;
+  s.T_camera_stair = Pose::Identity();
+  s.T_camera_stair.translation() = Eigen::Vector3f(0.f, 1.2f, 1.5f);
+  s.visible_steps = kind == StairKind::kAscending || kind == StairKind::kDescending ? std::vector<int>{1, 2, 3}
+                                                                                     : std::vector<int>{1};
+  s.visible_pixels.assign(s.visible_steps.size(), 1000);
+  s.first_edge_visible = s.both_ends_visible = true;
+  f.stairs.push_back(s);
+  return f;
+}
+
+/// A detection at the truth's edge: `kind` with one level at `height` (signed) above the floor.
+StairResult one_level_result(const FrameTruth& f, StairKind kind, float height) {
+  StairResult r;
+  r.detected = true;
+  r.verdict = StairVerdict::kDetected;
+  r.kind = kind;
+  r.levels = 1;
+  r.riser_m = std::fabs(height);
+  r.width_m = 1.2f;
+  r.T_camera_stair = f.stairs[0].T_camera_stair;
+  r.level_data.resize(2);
+  r.level_data[1].index = height > 0.f ? 1 : -1;
+  r.level_data[1].height = height;
+  return r;
+}
+
+TEST(StairsEval, ResultSaysWhichWayACurbGoes) {
+  const FrameTruth f = one_level_truth(StairKind::kCurb, true);
+  EXPECT_EQ(one_level_result(f, StairKind::kCurb, -0.15f).direction(), -1);
+  EXPECT_EQ(one_level_result(f, StairKind::kCurb, 0.15f).direction(), 1);
+  EXPECT_EQ(one_level_result(f, StairKind::kSingleStep, 0.15f).direction(), 1);
+  EXPECT_EQ(one_level_result(f, StairKind::kDescending, -0.15f).direction(), -1);
+  EXPECT_EQ(StairResult{}.direction(), 0);
+}
+
+TEST(StairsEval, CurbInTheWrongDirectionIsWrong) {
+  const FrameTruth down = one_level_truth(StairKind::kCurb, true);
+  // A curb down reported as a curb up at the very same edge: a miss and a false detection.
+  const StairFrameEval wrong = evaluate_stair_frame(one_level_result(down, StairKind::kCurb, 0.15f), down);
+  EXPECT_EQ(wrong.outcome, EvalOutcome::kFN);
+  EXPECT_TRUE(wrong.false_positive);
+  EXPECT_TRUE(wrong.wrong_direction);
+  EXPECT_STREQ(wrong.truth_label(), "curb_down");
+  EXPECT_STREQ(wrong.predicted_label(), "curb_up");
+  // ... and as a single step (up): the same.
+  EXPECT_TRUE(evaluate_stair_frame(one_level_result(down, StairKind::kSingleStep, 0.15f), down).wrong_direction);
+  // The right way: a TP of exactly the right kind.
+  const StairFrameEval right = evaluate_stair_frame(one_level_result(down, StairKind::kCurb, -0.15f), down);
+  EXPECT_EQ(right.outcome, EvalOutcome::kTP);
+  EXPECT_FALSE(right.wrong_direction);
+  EXPECT_TRUE(right.kind_exact());
+  EXPECT_TRUE(right.kind_ok());
+  // A curb up reported going down is as wrong.
+  const FrameTruth up = one_level_truth(StairKind::kCurb, false);
+  const StairFrameEval e = evaluate_stair_frame(one_level_result(up, StairKind::kCurb, -0.15f), up);
+  EXPECT_EQ(e.outcome, EvalOutcome::kFN);
+  EXPECT_TRUE(e.wrong_direction);
+
+  StairEvalTable table;
+  table.add(wrong, "unit");
+  table.add(right, "unit");
+  EXPECT_EQ(table.all.wrong_direction, 1);
+  EXPECT_EQ(table.all.fp, 1);
+  EXPECT_EQ(table.all.tp, 1);
+  EXPECT_EQ(table.all.confusion.at("curb_down").at("curb_up"), 1);
+  EXPECT_EQ(table.all.confusion.at("curb_down").at("curb_down"), 1);
+  EXPECT_NE(table.to_json().find("\"wrong_direction\": 1"), std::string::npos) << table.to_json();
+}
+
+TEST(StairsEval, SingleStepAsCurbUpIsRightForTheUserButNotExact) {
+  const FrameTruth f = one_level_truth(StairKind::kSingleStep, false);
+  const StairFrameEval e = evaluate_stair_frame(one_level_result(f, StairKind::kCurb, 0.16f), f);
+  EXPECT_EQ(e.outcome, EvalOutcome::kTP);
+  EXPECT_TRUE(e.kind_ok());      // one step up, at the right edge
+  EXPECT_FALSE(e.kind_exact());  // but not the kind the truth has
+  // A descending flight reported as a single curb down goes the right way but miscounts.
+  // (`down` is a curb's label: a descending truth goes down whatever it holds.)
+  const FrameTruth d = one_level_truth(StairKind::kDescending, false);
+  const StairFrameEval c = evaluate_stair_frame(one_level_result(d, StairKind::kCurb, -0.15f), d);
+  EXPECT_EQ(c.outcome, EvalOutcome::kTP);
+  EXPECT_FALSE(c.kind_ok());
+
+  StairEvalTable table;
+  table.add(e, "unit");
+  table.add(c, "unit");
+  EXPECT_EQ(table.all.tp, 2);
+  EXPECT_EQ(table.all.kind_correct, 0);
+  EXPECT_EQ(table.all.kind_ok, 1);
+  EXPECT_EQ(table.all.confusion.at("single_step").at("curb_up"), 1);
+  EXPECT_EQ(table.all.confusion.at("descending").at("curb_down"), 1);
+  const std::string json = table.to_json();
+  EXPECT_NE(json.find("\"confusion\": {\"descending\": {\"curb_down\": 1}, \"single_step\": {\"curb_up\": 1}}"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(table.to_text().find("kind confusion"), std::string::npos);
+}
+
+TEST(StairsEval, LabelsCarryTheCurbDirection) {
+  FrameTruth f = one_level_truth(StairKind::kCurb, true);
+  const std::string dir = std::string(STAIRGUIDE_BINARY_DIR) + "/test_stairs_labels";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/labels.yaml";
+  auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+  };
+  write(labels_to_yaml({f}));
+  const auto back = read_labels_yaml(path);
+  ASSERT_EQ(back.size(), 1u);
+  ASSERT_EQ(back[0].stairs.size(), 1u);
+  EXPECT_TRUE(back[0].stairs[0].down);
+  f.stairs[0].down = false;
+  write(labels_to_yaml({f}));
+  EXPECT_FALSE(read_labels_yaml(path)[0].stairs[0].down);
+
+  // A curb without a direction is refused, naming the file and the line; a descending one
+  // without the key goes down; a contradiction is refused.
+  std::string text = labels_to_yaml({f});
+  const std::string key = "        down: false\n";
+  const auto at = text.find(key);
+  ASSERT_NE(at, std::string::npos);
+  write(std::string(text).erase(at, key.size()));
+  try {
+    read_labels_yaml(path);
+    ADD_FAILURE() << "a curb without 'down' was accepted";
+  } catch (const SourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("labels.yaml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("down"), std::string::npos) << e.what();
+  }
+  f.stairs[0].kind = StairKind::kDescending;  // its `down` left false: the writer writes the kind's
+  text = labels_to_yaml({f});
+  const std::string key_down = "        down: true\n";
+  const auto at_down = text.find(key_down);
+  ASSERT_NE(at_down, std::string::npos) << text;
+  write(std::string(text).erase(at_down, key_down.size()));
+  EXPECT_TRUE(read_labels_yaml(path)[0].stairs[0].down);
+  write(std::string(text).replace(at_down, key_down.size(), key));  // descending with down: false
+  EXPECT_THROW(read_labels_yaml(path), SourceError);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/capture/synthetic.hpp"
@@ -16,30 +18,88 @@ namespace {
 
 using namespace stairguide;
 
-/// Static presets: independent views, perception reset before each. Sequences: a window of
-/// consecutive frames from 40 % of the walk (the approach), perception tracking the floor as it
-/// does in use, after a few frames of warm-up that are not scored.
+/// Static presets: independent views, perception reset before each. Sequences: the whole walk,
+/// every frame rendered and processed (perception tracks the floor from frame to frame at the
+/// sensor's 30 Hz, as in use), every kSequenceStride-th frame scored: the approach from far, the
+/// arrival at the first edge and the frames on the stairs (those are the traversal's and are
+/// skipped by the evaluation). Consecutive frames are nearly the same view: the stride keeps a
+/// 600-frame walk from outweighing the static views without hiding any stretch of it.
 constexpr int kStaticFrames = 16;
-constexpr int kSequenceFrames = 30;
-constexpr int kSequenceWarmup = 10;
+constexpr int kSequenceStride = 3;
 constexpr std::uint32_t kSeed = 5;
+
+/// Why an expected stair was missed, or something false was reported.
+enum class Cause {
+  kNoFloorInView,    ///< perception found no floor, and little floor is in view (truth)
+  kNoFloorFound,     ///< perception found no floor although the truth has it in view
+  kFloorDoubtful,    ///< the stairs stage refused the floor (a lower level nearer the user)
+  kNoCandidates,     ///< perception gave no step candidate
+  kStage,            ///< the stairs stage: candidates there but no validated staircase
+  kWrongDirection,   ///< detected at the true edge, going the wrong way
+  kElsewhere,        ///< detected, but nowhere near a true edge (false positive)
+  kFloorless,        ///< the floorless route (no floor) reported a staircase off the true edge
+  kKind              ///< a TP whose kind is wrong for the user (flight vs one step)
+};
+const char* to_string(Cause c) {
+  switch (c) {
+    case Cause::kNoFloorInView: return "perception: no floor (little in view)";
+    case Cause::kNoFloorFound: return "perception: no floor (floor in view)";
+    case Cause::kFloorDoubtful: return "stairs: floor doubtful";
+    case Cause::kNoCandidates: return "perception: no step candidates";
+    case Cause::kStage: return "stairs: rejected";
+    case Cause::kWrongDirection: return "stairs: wrong direction";
+    case Cause::kElsewhere: return "stairs: detection off the edge";
+    case Cause::kFloorless: return "stairs floorless: off the edge";
+    case Cause::kKind: return "stairs: kind (flight vs one step)";
+  }
+  return "?";
+}
 
 struct Miss {
   std::string scene;
-  long index = 0;
-  StairFrameEval eval;
+  long first = 0, last = 0;  ///< frame range (a run of consecutive scored frames with one cause)
+  int frames = 0;
+  Cause cause = Cause::kStage;
+  StairFrameEval eval;       ///< of the first frame of the run
   StairVerdict verdict = StairVerdict::kNoCandidates;
   StairKind got = StairKind::kNone;
   int levels = 0;
+  float distance = 0.f;      ///< m, user to the first edge at the first frame of the run
 };
+
+/// Recall by the user's distance to the first edge (along the staircase's direction).
+constexpr float kDistanceBins[] = {1.f, 2.f, 3.f, 1e9f};
+constexpr int kBins = 4;
 
 struct Suite {
   StairEvalTable table;
   int frames = 0;
-  int floor_missing_fn = 0;  ///< FNs on frames where perception found no floor (or it was doubted)
+  std::map<std::string, long> processed;  ///< frames run through perception, per preset
+  std::map<Cause, int> cause_frames;      ///< FN/FP/kind-wrong frames per cause
   std::vector<double> stage_ms;
-  std::vector<Miss> misses;  ///< FN and FP frames and TPs of the wrong kind, for the log
+  std::vector<Miss> misses;  ///< FN and FP frames and TPs of the wrong kind, runs merged
+  int bin_tp[kBins] = {}, bin_fn[kBins] = {};
 };
+
+/// Distance from the user (camera) to the first edge of the expected stair with most treads in
+/// view, along z_S; negative past it. NaN when no stair is expected.
+float edge_distance(const FrameTruth& t) {
+  const StairTruth* best = nullptr;
+  for (const auto& s : t.stairs)
+    if (!s.visible_steps.empty() && (!best || s.visible_steps.size() > best->visible_steps.size())) best = &s;
+  if (!best) return std::nanf("");
+  return -(best->T_camera_stair.inverse().translation().z());
+}
+
+Cause cause_of(const StairFrameEval& e, const StairResult& r, const SceneResult& scene, const FrameTruth& t) {
+  if (e.outcome == EvalOutcome::kTP) return Cause::kKind;
+  if (e.wrong_direction) return Cause::kWrongDirection;
+  if (r.detected) return r.without_floor ? Cause::kFloorless : Cause::kElsewhere;
+  if (!scene.floor_found) return t.floor_visible ? Cause::kNoFloorFound : Cause::kNoFloorInView;
+  if (r.verdict == StairVerdict::kFloorDoubtful) return Cause::kFloorDoubtful;
+  if (r.verdict == StairVerdict::kNoCandidates) return Cause::kNoCandidates;
+  return Cause::kStage;
+}
 
 Suite run_suite() {
   Suite out;
@@ -53,26 +113,39 @@ Suite run_suite() {
   const synth::SynthOptions opt;
   for (const auto& p : synth::presets()) {
     const bool sequence = p.default_frames > 1;
-    const long first = sequence ? p.default_frames * 2 / 5 - kSequenceWarmup : 0;
-    const long count = sequence ? kSequenceWarmup + kSequenceFrames : kStaticFrames;
+    const long count = sequence ? p.default_frames : kStaticFrames;
     perception.reset();
-    for (long i = first; i < first + count; ++i) {
+    for (long i = 0; i < count; ++i) {
       synth::render_preset_frame(p.name, i, kSeed, opt, frame, truth);
       if (!sequence) perception.reset();  // independent views
       perception.process(frame, scene);
       stage.run(scene, frame.intrinsics, result);
-      if (sequence && i < first + kSequenceWarmup) continue;
+      ++out.processed[p.name];
+      if (sequence && i % kSequenceStride != 0) continue;
       const StairFrameEval e = evaluate_stair_frame(result, truth);
       out.table.add(e, p.name);
       out.stage_ms.push_back(result.timings.total_ms);
-      if (e.outcome == EvalOutcome::kFN && (result.verdict == StairVerdict::kNoFloor ||
-                                            result.verdict == StairVerdict::kFloorDoubtful))
-        ++out.floor_missing_fn;
-      if (e.outcome == EvalOutcome::kFN || e.outcome == EvalOutcome::kFP ||
-          (e.outcome == EvalOutcome::kTP && e.predicted_kind != e.truth_kind))
-        out.misses.push_back({p.name, i, e, result.verdict, result.detected ? result.kind : StairKind::kNone,
-                              result.levels});
       ++out.frames;
+      const float dist = edge_distance(truth);
+      if (e.outcome == EvalOutcome::kTP || e.outcome == EvalOutcome::kFN) {
+        int b = 0;
+        while (b < kBins - 1 && !(dist < kDistanceBins[b])) ++b;
+        (e.outcome == EvalOutcome::kTP ? out.bin_tp : out.bin_fn)[b]++;
+      }
+      const bool bad = e.outcome == EvalOutcome::kFN || e.outcome == EvalOutcome::kFP || e.false_positive ||
+                       (e.outcome == EvalOutcome::kTP && !e.kind_ok());
+      if (!bad) continue;
+      const Cause c = cause_of(e, result, scene, truth);
+      ++out.cause_frames[c];
+      Miss* last = out.misses.empty() ? nullptr : &out.misses.back();
+      if (sequence && last && last->scene == p.name && last->cause == c && last->last + kSequenceStride == i &&
+          last->eval.outcome == e.outcome) {
+        last->last = i;
+        ++last->frames;
+      } else {
+        out.misses.push_back({p.name, i, i, 1, c, e, result.verdict, result.detected ? result.kind : StairKind::kNone,
+                              result.levels, dist});
+      }
     }
   }
   return out;
@@ -83,10 +156,26 @@ Suite run_suite() {
 TEST(StairsSynthetic, Suite) {
   const Suite s = run_suite();
   std::printf("%s", s.table.to_text().c_str());
-  for (const Miss& m : s.misses)
-    std::printf("miss: %-28s %4ld %-3s truth %-11s (%d treads%s) got %-11s %d levels (%s)\n", m.scene.c_str(), m.index,
-                to_string(m.eval.outcome), to_string(m.eval.truth_kind), m.eval.truth_visible_steps,
-                m.eval.fully_visible ? ", fully visible" : "", to_string(m.got), m.levels, to_string(m.verdict));
+  for (const Miss& m : s.misses) {
+    char range[48];
+    if (m.first == m.last)
+      std::snprintf(range, sizeof range, "%ld", m.first);
+    else
+      std::snprintf(range, sizeof range, "%ld-%ld (%d)", m.first, m.last, m.frames);
+    std::printf("miss: %-28s %-16s %-3s %-36s truth %-11s (%d treads%s, edge %.1f m) got %-11s %d levels (%s)\n",
+                m.scene.c_str(), range, to_string(m.eval.outcome), to_string(m.cause), m.eval.truth_label(),
+                m.eval.truth_visible_steps, m.eval.fully_visible ? ", fully visible" : "", m.distance,
+                m.eval.predicted_label(), m.levels, to_string(m.verdict));
+  }
+  std::printf("frames processed per preset:");
+  for (const auto& [name, n] : s.processed) std::printf(" %s %ld;", name.c_str(), n);
+  std::printf("\nbad frames by cause:\n");
+  for (const auto& [c, n] : s.cause_frames) std::printf("  %-40s %d\n", to_string(c), n);
+  std::printf("recall by distance from the user to the first edge:");
+  for (int b = 0; b < kBins; ++b)
+    std::printf(" <%.0f m: %d/%d;", kDistanceBins[b] > 100 ? 99.0 : kDistanceBins[b], s.bin_tp[b],
+                s.bin_tp[b] + s.bin_fn[b]);
+  std::printf("\n");
   const EvalSummary& a = s.table.all;
 
   {
@@ -103,21 +192,51 @@ TEST(StairsSynthetic, Suite) {
 
   {
     SCOPED_TRACE("detects staircases in view");
-    std::printf("recall %.4f (%d TP, %d FN; %d FN where perception had no trustworthy floor), "
+    auto count = [&](std::initializer_list<Cause> cs) {
+      int n = 0;
+      for (Cause c : cs) {
+        const auto it = s.cause_frames.find(c);
+        n += it == s.cause_frames.end() ? 0 : it->second;
+      }
+      return n;
+    };
+    const int perception_fn = count({Cause::kNoFloorInView, Cause::kNoFloorFound, Cause::kNoCandidates});
+    std::printf("recall %.4f (%d TP, %d FN; %d FN where perception gave no floor or no candidate), "
                 "fully visible %.4f (%d frames)\n",
-                a.recall(), a.tp, a.fn, s.floor_missing_fn, a.recall_fully_visible(), a.full_tp + a.full_fn);
-    // Issue 4 asks for 99 % on frames with two or more steps fully visible: NOT reached (measured
-    // 0.945 over fully visible stairs, 0.951 where perception gave a trustworthy floor). The bounds
-    // below are the measured figures less a margin, so a regression fails. The fully visible
-    // misses left are all perception's: frames without a floor (2) and a descending flight behind
-    // a person whose treads show as a few pixel rows that no region is grown from (3).
-    const int stage_fn = a.fn - s.floor_missing_fn;
-    const double stage_recall = static_cast<double>(a.tp) / (a.tp + stage_fn);
-    std::printf("recall of the stairs stage where perception found the floor: %.4f\n", stage_recall);
-    EXPECT_GE(stage_recall, 0.92);
-    // The overall figures depend on perception's floor too (which is still changing): a loose guard.
-    EXPECT_GE(a.recall(), 0.75);
-    EXPECT_GE(a.recall_fully_visible(), 0.80);
+                a.recall(), a.tp, a.fn, perception_fn, a.recall_fully_visible(), a.full_tp + a.full_fn);
+    for (const char* kind : {"ascending", "descending"}) {
+      const auto it = s.table.by_kind.find(kind);
+      if (it != s.table.by_kind.end())
+        std::printf("  %-10s recall %.4f (%d TP, %d FN), fully visible %.4f (%d frames)\n", kind, it->second.recall(),
+                    it->second.tp, it->second.fn, it->second.recall_fully_visible(),
+                    it->second.full_tp + it->second.full_fn);
+    }
+    const double stage_recall = static_cast<double>(a.tp) / std::max(1, a.tp + a.fn - perception_fn);
+    std::printf("recall where perception gave a floor and step candidates: %.4f\n", stage_recall);
+    // Measured on the whole walks (stride 3, seed 5, floorless route off, tree of this writing):
+    // recall 0.545, fully visible 0.952, 0.695 where perception gave a floor and candidates; from
+    // 1 m out 130 of 133 frames, within 1 m of the first edge 41 of 181. Issue 4's 99 % is NOT
+    // reached. The misses are the arrival: on an ascending flight the floor leaves the view within
+    // ~0.5 m of the first edge (perception: no floor); on a descending one the floor is doubted
+    // (a lower level nearer the user) or the first tread is no longer connected to the strip of
+    // floor left in view (stairs stage). The bounds are the measured figures less a margin, so a
+    // regression fails; raise them as those misses are fixed.
+    EXPECT_GE(a.recall(), 0.50);
+    EXPECT_GE(a.recall_fully_visible(), 0.90);
+    EXPECT_GE(stage_recall, 0.65);
+    const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3], far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
+    std::printf("recall from 1 m out: %.4f (%d frames)\n", static_cast<double>(far_tp) / std::max(1, far_tp + far_fn),
+                far_tp + far_fn);
+    EXPECT_GE(far_tp + far_fn, 100);
+    EXPECT_GE(far_tp, 0.95 * (far_tp + far_fn));
+    // Every walk is scored from end to end (stairs skipped only while the user is on them).
+    for (const auto& p : synth::presets())
+      if (p.default_frames > 1) {
+        EXPECT_EQ(s.processed.at(p.name), p.default_frames) << p.name;
+        EXPECT_EQ(s.table.by_scene.at(p.name).frames, (p.default_frames + kSequenceStride - 1) / kSequenceStride)
+            << p.name;
+        EXPECT_GE(s.table.by_scene.at(p.name).tp, 10) << p.name;
+      }
     for (const char* kind : {"ascending", "descending"}) {
       const auto it = s.table.by_kind.find(kind);
       ASSERT_NE(it, s.table.by_kind.end()) << kind;
@@ -138,10 +257,19 @@ TEST(StairsSynthetic, Suite) {
       const EvalSummary& e = sc.at(name);
       EXPECT_GE(e.tp, 8) << name;
       EXPECT_GE(e.recall(), 0.8) << name;
-      // A platform 2.5 m wide and deep filling the view cannot be told from another floor level:
-      // some single steps come out as curbs (measured 10 of 13); curbs come out as curbs.
-      EXPECT_GE(4 * e.kind_correct, 3 * e.tp) << name << ": single step taken for a curb or back";
+      // What the user needs of one step: up or down, one step, where its edge is. All of them right.
+      EXPECT_EQ(e.kind_ok, e.tp) << name;
+      EXPECT_EQ(e.wrong_direction, 0) << name;
     }
+    // A platform 2.5 m deep filling the view (far end and both sides out of the image) cannot be
+    // told from another floor level in one frame: it is reported as a curb up (measured 3 of 13,
+    // right in direction, count and edge; the confusion table shows them). Curbs, up and down,
+    // come out as curbs going the right way.
+    EXPECT_GE(4 * sc.at("single_step_static").kind_correct, 3 * sc.at("single_step_static").tp);
+    EXPECT_EQ(sc.at("curb_static").kind_correct, sc.at("curb_static").tp);
+    EXPECT_EQ(a.wrong_direction, 0) << "a detection at a true edge going the wrong way";
+    EXPECT_GE(a.confusion.at("curb_up").at("curb_up") + 0, 3);
+    EXPECT_GE(a.confusion.at("curb_down").at("curb_down") + 0, 3);
   }
 
   {

@@ -154,6 +154,7 @@ std::string labels_to_yaml(const std::vector<FrameTruth>& frames) {
       o << "        tread_m: " << f9(s.tread_m) << "\n";
       o << "        width_m: " << f9(s.width_m) << "\n";
       o << "        open_risers: " << b(s.open_risers) << "\n";
+      o << "        down: " << b(s.goes_down()) << "\n";
       o << "        T_camera_stair: " << matrix16(s.T_camera_stair) << "\n";
       o << "        visible_steps: " << list(s.visible_steps) << "\n";
       o << "        visible_pixels: " << list(s.visible_pixels) << "\n";
@@ -214,6 +215,19 @@ std::vector<FrameTruth> read_labels_yaml(const std::string& path) {
       t.tread_m = s.scalar<float>("tread_m");
       t.width_m = s.scalar<float>("width_m");
       t.open_risers = s.scalar<bool>("open_risers");
+      // `down` came after the first labels: a staircase's kind implies it (and must agree), a curb's
+      // does not, so a curb without it is refused rather than guessed.
+      if (sn["down"]) {
+        t.down = s.scalar<bool>("down");
+        if ((t.kind == StairKind::kAscending || t.kind == StairKind::kSingleStep) && t.down)
+          throw s.err(sn["down"], std::string("a ") + to_string(t.kind) + " cannot go down ('down: true')");
+        if (t.kind == StairKind::kDescending && !t.down)
+          throw s.err(sn["down"], "a descending staircase goes down ('down: false' given)");
+      } else if (t.kind == StairKind::kCurb) {
+        throw s.err(sn, "a curb needs 'down: true' (the ground drops) or 'down: false' (it rises)");
+      } else {
+        t.down = t.kind == StairKind::kDescending;
+      }
       t.T_camera_stair = s.pose("T_camera_stair");
       t.visible_steps = s.ints("visible_steps");
       t.visible_pixels = s.ints("visible_pixels");

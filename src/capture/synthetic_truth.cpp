@@ -91,6 +91,7 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
     st.tread_m = sp.tread_m;
     st.width_m = sp.width_m;
     st.open_risers = sp.open_risers;
+    st.down = sp.down;
     st.T_camera_stair = T_cw * sp.T_world_stair;
     for (int k = 1; k <= sp.steps; ++k) {
       const int c = counts[static_cast<std::size_t>(slot_base[i] + k)];

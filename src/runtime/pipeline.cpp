@@ -95,27 +95,30 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const Pose* /*T_w
   out.seq = frame.index;
   out.ran = true;
   out.floor_found = m.scene.floor_found;
-  if (!m.scene.floor_found) {
-    out.state = "no_floor";
-    out.detail = m.scene.why.empty() ? "no floor" : m.scene.why;
-    m.stair = StairResult{};
-    m.stair.verdict = StairVerdict::kNoFloor;
-  } else {
-    m.stairs.run(m.scene, m.stair);
-    out.stair_detected = m.stair.detected;
-    if (m.stair.detected) {
-      out.state = to_string(m.stair.kind);
-      out.levels = m.stair.levels;
-      char buf[160];
+  // The stair stage runs without a floor too: its floorless route (when configured) finds a stack
+  // of treads by their own vertical, with the distance from the user's feet unknown.
+  m.stairs.run(m.scene, &frame.intrinsics, m.stair);
+  out.stair_detected = m.stair.detected;
+  if (m.stair.detected) {
+    out.state = to_string(m.stair.kind);
+    out.levels = m.stair.levels;
+    char buf[200];
+    if (m.stair.without_floor)
       std::snprintf(buf, sizeof buf,
-                    "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
+                    "%s, %d levels seen, riser %.1f cm, tread %.1f cm, no floor in view: distance and first step "
+                    "unknown",
+                    to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m);
+    else
+      std::snprintf(buf, sizeof buf, "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
                     to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m,
                     m.stair.width_m, m.stair.origin().norm());
-      out.detail = buf;
-    } else {
-      out.state = "floor";
-      out.detail = std::string("floor, no stairs: ") + to_string(m.stair.verdict);
-    }
+    out.detail = buf;
+  } else if (!m.scene.floor_found) {
+    out.state = "no_floor";
+    out.detail = m.scene.why.empty() ? "no floor" : m.scene.why;
+  } else {
+    out.state = "floor";
+    out.detail = std::string("floor, no stairs: ") + to_string(m.stair.verdict);
   }
   out.ms = ms_since(t0);
   return out;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 namespace stairguide {
 
@@ -21,31 +23,10 @@ const char* to_string(EvalOutcome o) {
 
 namespace {
 
-bool truth_goes_up(const StairTruth& s, const FrameTruth& f) {
-  switch (s.kind) {
-    case StairKind::kAscending:
-    case StairKind::kSingleStep: return true;
-    case StairKind::kDescending: return false;
-    default: break;
-  }
-  // A curb's origin is on the user's level when the ground drops, one riser up when it rises.
-  // The camera height says where the user's floor is in the camera frame.
-  const Eigen::Vector3f up_w = Eigen::Vector3f::UnitZ();
-  const Eigen::Vector3f o_w = f.T_world_camera * s.T_camera_stair.translation();
-  const Eigen::Vector3f cam_w = f.T_world_camera.translation();
-  const float origin_height = f.camera_height_m - (cam_w - o_w).dot(up_w);
-  return origin_height > 0.5f * s.riser_m;
-}
+// Which way the truth goes: its kind says it, a curb's label (StairTruth::down) for a curb.
+bool truth_goes_up(const StairTruth& s) { return !s.goes_down(); }
 
-bool result_goes_up(const StairResult& r) {
-  switch (r.kind) {
-    case StairKind::kAscending:
-    case StairKind::kSingleStep: return true;
-    case StairKind::kDescending: return false;
-    default: break;
-  }
-  return r.level_data.size() > 1 && r.level_data[1].height > 0.f;
-}
+bool result_goes_up(const StairResult& r) { return r.direction() > 0; }
 
 bool expected(const StairTruth& s) {
   const std::size_t need = (s.kind == StairKind::kSingleStep || s.kind == StairKind::kCurb) ? 1 : 2;
@@ -61,10 +42,35 @@ float line_distance(const Eigen::Vector3f& p, const Eigen::Vector3f& o, const Ei
 
 }  // namespace
 
+const char* kind_label(StairKind kind, bool down) {
+  if (kind == StairKind::kCurb) return down ? "curb_down" : "curb_up";
+  return to_string(kind);
+}
+
+static const char* kind_class(StairKind kind, bool down) {
+  switch (kind) {
+    case StairKind::kAscending: return "flight_up";
+    case StairKind::kDescending: return "flight_down";
+    case StairKind::kSingleStep: return "one_step_up";
+    case StairKind::kCurb: return down ? "one_step_down" : "one_step_up";
+    default: return "none";
+  }
+}
+
+const char* StairFrameEval::truth_label() const { return kind_label(truth_kind, truth_down); }
+const char* StairFrameEval::predicted_label() const { return kind_label(predicted_kind, predicted_direction < 0); }
+bool StairFrameEval::kind_exact() const {
+  return std::string(truth_label()) == predicted_label();
+}
+bool StairFrameEval::kind_ok() const {
+  return std::string(kind_class(truth_kind, truth_down)) == kind_class(predicted_kind, predicted_direction < 0);
+}
+
 StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, const StairEvalOptions& opt) {
   StairFrameEval e;
   e.predicted_kind = r.detected ? r.kind : StairKind::kNone;
   e.predicted_levels = r.detected ? r.levels : 0;
+  e.predicted_direction = r.detected ? r.direction() : 0;
   // On the stairs (climbing or descending) the steps are the traversal's business (paper 5), and
   // the first edge lies behind the user: such frames are not scored.
   for (const auto& s : f.stairs)
@@ -88,17 +94,26 @@ StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, c
     const Eigen::Vector3f o = r.T_camera_stair.translation();
     float best = opt.match_distance;
     for (const auto& s : f.stairs) {
-      if (!visible(s) || truth_goes_up(s, f) != result_goes_up(r)) continue;
+      if (!visible(s)) continue;
       const float d = opt.ignore_pose ? 0.f
                                       : line_distance(o, s.T_camera_stair.translation(), s.T_camera_stair.linear().col(0));
+      if (d > opt.match_distance) continue;
+      // At the right edge but the wrong way (a curb down reported as a step up): no match, and
+      // counted apart, since it is the answer that makes someone fall.
+      if (truth_goes_up(s) != result_goes_up(r)) {
+        e.wrong_direction = true;
+        continue;
+      }
       if (d <= best) {
         best = d;
         match = &s;
       }
     }
   }
+  if (match) e.wrong_direction = false;
   if (match) main = match;
   e.truth_kind = main ? main->kind : StairKind::kNone;
+  e.truth_down = main && main->goes_down();
   e.truth_visible_steps = main ? static_cast<int>(main->visible_steps.size()) : 0;
   e.fully_visible = main && expected(*main) && main->first_edge_visible && main->both_ends_visible;
   if (!r.detected) {
@@ -163,10 +178,14 @@ void EvalSummary::add(const StairFrameEval& e) {
     case EvalOutcome::kSkipped: ++skipped; break;
   }
   if (e.outcome == EvalOutcome::kFP || e.false_positive) ++fp;
+  if (e.wrong_direction) ++wrong_direction;
+  // The confusion covers the scored frames (not those skipped): truth kind -> what was reported.
+  if (e.outcome != EvalOutcome::kSkipped) ++confusion[e.truth_label()][e.predicted_label()];
   if (e.fully_visible && e.outcome == EvalOutcome::kTP) ++full_tp;
   if (e.fully_visible && e.outcome == EvalOutcome::kFN) ++full_fn;
   if (e.outcome != EvalOutcome::kTP) return;
-  if (e.predicted_kind == e.truth_kind) ++kind_correct;
+  if (e.kind_exact()) ++kind_correct;
+  if (e.kind_ok()) ++kind_ok;
   if (e.has_riser) riser.add(e.riser_err);
   if (e.has_tread) tread.add(e.tread_err);
   if (e.has_width) width.add(e.width_err);
@@ -198,6 +217,8 @@ std::string summary_json(const EvalSummary& s) {
   kv("precision", json_number(s.precision()));
   kv("recall", json_number(s.recall()));
   kv("kind_correct", json_number(s.kind_correct));
+  kv("kind_ok", json_number(s.kind_ok));
+  kv("wrong_direction", json_number(s.wrong_direction));
   kv("recall_fully_visible", json_number(s.recall_fully_visible()));
   kv("fully_visible_frames", json_number(s.full_tp + s.full_fn));
   auto stats = [&](const char* name, const ErrorStats& e, const char* unit) {
@@ -222,6 +243,19 @@ std::string summary_json(const EvalSummary& s) {
 std::string StairEvalTable::to_json() const {
   std::string o = summary_json(all);
   o.pop_back();
+  o += ", \"confusion\": {";
+  bool first_truth = true;
+  for (const auto& [truth, row] : all.confusion) {
+    o += (first_truth ? "" : ", ") + json_quote(truth) + ": {";
+    first_truth = false;
+    bool first = true;
+    for (const auto& [pred, n] : row) {
+      o += (first ? "" : ", ") + json_quote(pred) + ": " + json_number(n);
+      first = false;
+    }
+    o += "}";
+  }
+  o += "}";
   for (const auto* group : {&by_kind, &by_scene}) {
     o += group == &by_kind ? ", \"by_kind\": {" : ", \"by_scene\": {";
     bool first = true;
@@ -261,6 +295,34 @@ std::string StairEvalTable::to_text() const {
   for (const auto& [k, v] : by_kind) row("  " + k, v);
   o += "by scene:\n";
   for (const auto& [k, v] : by_scene) row("  " + k, v);
+  std::snprintf(line, sizeof line,
+                "kind on TPs: %d exact, %d right as far as the user is concerned (direction, one step or a "
+                "flight), of %d; %d detections at a true edge going the wrong way\n",
+                all.kind_correct, all.kind_ok, all.tp, all.wrong_direction);
+  o += line;
+  o += "kind confusion (scored frames; rows truth, columns reported):\n";
+  std::vector<std::string> cols;
+  for (const auto& [truth, row] : all.confusion)
+    for (const auto& [pred, n] : row)
+      if (std::find(cols.begin(), cols.end(), pred) == cols.end()) cols.push_back(pred);
+  std::sort(cols.begin(), cols.end());
+  std::snprintf(line, sizeof line, "  %-14s", "");
+  o += line;
+  for (const auto& c : cols) {
+    std::snprintf(line, sizeof line, " %12s", c.c_str());
+    o += line;
+  }
+  o += "\n";
+  for (const auto& [truth, row] : all.confusion) {
+    std::snprintf(line, sizeof line, "  %-14s", truth.c_str());
+    o += line;
+    for (const auto& c : cols) {
+      const auto it = row.find(c);
+      std::snprintf(line, sizeof line, " %12d", it == row.end() ? 0 : it->second);
+      o += line;
+    }
+    o += "\n";
+  }
   o += "errors: mean |error| +- sigma of the signed error, on true positives; width and edge where both ends "
        "are visible,\nedge line = distance of the true edge centre to the estimated edge line.\n";
   return o;

@@ -32,8 +32,11 @@ const char* to_string(StairVerdict v) {
 }
 
 StairStage::StairStage(const ClassificationConfig& classification, const StairDetectionConfig& detection,
-                       const StairModellingConfig& modelling)
-    : detection_(classification, detection), modelling_(classification, detection, modelling) {}
+                       const StairModellingConfig& modelling, const FloorConfig& floor)
+    : detection_(classification, detection),
+      modelling_(classification, detection, modelling),
+      floorless_(classification, detection, modelling, floor),
+      floorless_on_(detection.floorless) {}
 
 namespace {
 
@@ -48,6 +51,7 @@ void reset(StairResult& r, StairVerdict v, int candidates) {
   r.edge_left.setZero();
   r.edge_right.setZero();
   r.method = StairAxesMethod::kNone;
+  r.without_floor = false;
   r.level_data.clear();
   r.candidates = candidates;
   r.rejected_candidates = candidates;
@@ -68,6 +72,19 @@ void StairStage::run(const SceneResult& scene, const CameraIntrinsics* K, StairR
   detection_.run(scene, detection_out_);
   const auto t1 = clock::now();
   const auto& d = detection_out_;
+  if (d.verdict == StairVerdict::kNoFloor && floorless_on_) {
+    // No floor, so no heights: the horizontal planes themselves give the vertical (floorless.hpp).
+    reset(other_, d.verdict, d.candidates);
+    floorless_.run(scene, K, out);
+    // Without a stack of levels the reason stays "no floor"; a rejected stack says why.
+    if (!out.detected && out.levels < 2) out.verdict = StairVerdict::kNoFloor;
+    const auto t2 = clock::now();
+    auto ms = [](clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
+    out.timings.detection_ms = ms(t1 - t0);
+    out.timings.modelling_ms = ms(t2 - t1);
+    out.timings.total_ms = ms(t2 - t0);
+    return;
+  }
   reset(up_, d.ascending.verdict, d.ascending.candidates);
   reset(down_, d.descending.verdict, d.descending.candidates);
   if (d.verdict == StairVerdict::kDetected) {

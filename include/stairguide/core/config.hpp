@@ -226,6 +226,12 @@ struct StairDetectionConfig {
   float single_min_width = 0.8f;       ///< m, a single level narrower than this is an obstacle
   float single_min_depth = 0.7f;       ///< m, a single level shallower than this is an obstacle
   float curb_min_depth = 2.6f;         ///< m, a single raised level deeper than this is another floor (curb)
+  // Floorless route (stairs/floorless.hpp): stairs found when perception saw no floor.
+  bool floorless = false;              ///< look for stairs from the horizontal planes alone when there is no floor (off: see floorless.hpp)
+  float floorless_tilt_min = -0.17453293f;  ///< rad, lowest camera pitch below horizontal implied by the planes (-10 deg: about level)
+  float floorless_tilt_max = 1.3962634f;    ///< rad, highest (80 deg: looking steeply down at the steps before the feet)
+  int floorless_min_level_pixels = 500;     ///< px, smallest level (all its regions) of a floorless stack
+  int floorless_min_levels = 2;             ///< levels one riser apart needed without a floor
 
   template <class V> void visit(V& v) {
     v.num(same_level_tolerance, "same_level_tolerance_cm", Unit::kCentimetre, 0.5, 20,
@@ -244,6 +250,16 @@ struct StairDetectionConfig {
           "a single level shallower than this is an obstacle, not a step");
     v.num(curb_min_depth, "curb_min_depth_m", Unit::kMetre, 0.1, 100,
           "a single raised level deeper than this, or running out of view on both sides and the far side, is another floor level (a curb)");
+    v.flag(floorless, "floorless",
+           "without a floor, look for a stack of horizontal planes one riser apart (heights then relative, distance to the feet unknown)");
+    v.num(floorless_tilt_min, "floorless_tilt_min_deg", Unit::kDegree, -90, 90,
+          "floorless: lowest camera pitch below horizontal the horizontal planes may imply (negative: looking up)");
+    v.num(floorless_tilt_max, "floorless_tilt_max_deg", Unit::kDegree, -90, 90,
+          "floorless: highest camera pitch below horizontal the horizontal planes may imply");
+    v.num(floorless_min_level_pixels, "floorless_min_level_pixels", Unit::kPixel, 1, 1000000,
+          "floorless: smallest level (all its regions), pixels");
+    v.num(floorless_min_levels, "floorless_min_levels", Unit::kCount, 2, 100,
+          "floorless: levels one riser apart needed to report a staircase");
   }
 };
 

@@ -33,12 +33,19 @@ struct StairTruth {
   float tread_m = 0.f;               ///< m, horizontal distance edge to edge
   float width_m = 0.f;               ///< m
   bool open_risers = false;
+  /// A curb: the ground beyond its edge is lower than the user's floor (a curb down taken for a
+  /// step up is a fall, and the kind alone cannot say which way a curb goes). For the other kinds
+  /// the kind says it; use goes_down().
+  bool down = false;
   Pose T_camera_stair = Pose::Identity();  ///< stair frame S into camera frame C
   std::vector<int> visible_steps;    ///< 1-based indices of treads with >= 200 visible pixels
   std::vector<int> visible_pixels;   ///< visible tread pixels, one per entry of visible_steps
   bool first_edge_visible = false;   ///< the first step's edge is in view (not occluded)
   bool both_ends_visible = false;    ///< both ends of the first edge are in view (width measurable)
   int user_step = 0;                 ///< tread the user stands on: 0 = floor before it, k = step k
+
+  /// The surface beyond the first edge is lower than the user's floor: descending, or a curb down.
+  bool goes_down() const { return kind == StairKind::kDescending || (kind == StairKind::kCurb && down); }
 };
 
 /// Ground truth of one frame.

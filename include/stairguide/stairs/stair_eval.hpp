@@ -7,8 +7,15 @@
 ///  - a truth stair is *expected* when it has at least two visible treads (one for a single step or
 ///    curb): those frames make the recall;
 ///  - a detection *matches* a truth stair when it goes the same way (up: ascending, single step,
-///    curb up; down: descending, curb down) and its first edge lies within `match_distance` of the
-///    true first edge (perpendicular distance to the true edge line);
+///    curb up; down: descending, curb down; StairResult::direction() against StairTruth::goes_down()) and
+///    its first edge lies within `match_distance` of the true first edge (perpendicular distance to
+///    the true edge line). A detection at a true edge going the other way matches nothing and is
+///    counted in `wrong_direction` as well (a curb down reported as a step up is a fall);
+///  - the kind is scored apart from detection: `kind_correct` counts TPs of exactly the true kind
+///    (a curb in the true direction), `kind_ok` those right as far as the user is concerned: the
+///    same direction and the same count class, one step (single step, curb) or a flight. A single
+///    step reported as a curb up (a platform filling the view is another floor level for all one
+///    frame shows) is kind_ok but not kind_correct; the confusion table shows every such case;
 ///  - TP: an expected stair detected and matched; FN: an expected stair not matched; FP: a
 ///    detection that matches no visible truth stair; TN: no visible stair, nothing detected. A
 ///    frame whose only stair is visible but not expected (one tread in view) and is not detected
@@ -39,6 +46,9 @@ struct StairFrameEval {
   bool false_positive = false;      ///< also true for an FN frame with a detection somewhere else
   StairKind truth_kind = StairKind::kNone;      ///< kind of the matched (or main visible) truth stair
   StairKind predicted_kind = StairKind::kNone;  ///< kNone when nothing was detected
+  bool truth_down = false;          ///< StairTruth::goes_down() of that truth stair
+  int predicted_direction = 0;      ///< StairResult::direction() of the detection, 0 when none
+  bool wrong_direction = false;     ///< a detection at a true stair's edge but going the other way
   int truth_visible_steps = 0;
   bool fully_visible = false;       ///< an expected stair whose first edge is in view with both ends
   bool on_stairs = false;           ///< the user stands on a step (not scored: traversal's frames)
@@ -48,7 +58,20 @@ struct StairFrameEval {
   float edge_pos_err = 0.f;   ///< m, distance between estimated and true first-edge centres
   float edge_line_err = 0.f;  ///< m, distance from the true centre to the estimated edge line
   float yaw_err_deg = 0.f;    ///< deg, |angle| between estimated and true z_S about the vertical
+
+  /// Kind names with a curb's direction: "ascending", "descending", "single_step", "curb_up",
+  /// "curb_down", "none".
+  const char* truth_label() const;
+  const char* predicted_label() const;
+  /// The reported kind is the true one (a curb in the right direction).
+  bool kind_exact() const;
+  /// The reported kind is right for the user: same direction, and one step (single step or curb)
+  /// against a flight (ascending or descending) told right.
+  bool kind_ok() const;
 };
+
+/// "ascending", "descending", "single_step", "curb_up", "curb_down" or "none".
+const char* kind_label(StairKind kind, bool down);
 
 struct StairEvalOptions {
   float match_distance = 0.25f;  ///< m, first edges farther apart than this do not match
@@ -74,7 +97,12 @@ struct ErrorStats {
 /// Counts and error statistics over many frames.
 struct EvalSummary {
   int frames = 0, tp = 0, fp = 0, tn = 0, fn = 0, skipped = 0;
-  int kind_correct = 0;  ///< TPs whose predicted kind equals the truth kind
+  int kind_correct = 0;  ///< TPs whose predicted kind equals the truth kind (a curb's direction too)
+  int kind_ok = 0;       ///< TPs whose kind is right for the user (StairFrameEval::kind_ok)
+  int wrong_direction = 0;  ///< frames with a detection at a true edge going the wrong way
+  /// Scored (not skipped) frames by truth label then reported label (kind_label; "none" when
+  /// nothing was detected or no stair was in view).
+  std::map<std::string, std::map<std::string, int>> confusion;
   int full_tp = 0, full_fn = 0;  ///< TP / FN among frames whose stair is fully visible (first edge, both ends)
   ErrorStats riser, tread, width, edge_pos, edge_line, yaw;
   void add(const StairFrameEval& e);
@@ -90,8 +118,9 @@ struct StairEvalTable {
   std::map<std::string, EvalSummary> by_scene;  ///< key: FrameTruth::scene
   void add(const StairFrameEval& e, const std::string& scene);
 
-  /// One JSON object: tp, fp, tn, fn, precision, recall, riser/tread/width/edge/yaw statistics,
-  /// by_kind and by_scene objects with the same keys.
+  /// One JSON object: tp, fp, tn, fn, precision, recall, kind_correct, kind_ok, wrong_direction,
+  /// riser/tread/width/edge/yaw statistics, the overall `confusion` (truth label -> reported
+  /// label -> frames), by_kind and by_scene objects with the same keys (no confusion).
   std::string to_json() const;
   /// A human-readable table.
   std::string to_text() const;

@@ -71,10 +71,29 @@ struct StairResult {
   Eigen::Vector3f edge_left = Eigen::Vector3f::Zero();   ///< camera frame, +x_S end of the first edge
   Eigen::Vector3f edge_right = Eigen::Vector3f::Zero();  ///< camera frame, -x_S end of the first edge
   StairAxesMethod method = StairAxesMethod::kNone;
+  /// Found without a floor (stairs/floorless.hpp): level 0 is a virtual level one riser beyond the
+  /// first seen level, heights are relative to it, and the distance from the user's feet (and
+  /// whether the first seen level is the first step) is unknown.
+  bool without_floor = false;
   std::vector<StairLevel> level_data;     ///< floor first (index 0), then each step level in order
   int candidates = 0;                     ///< step candidates considered
   int rejected_candidates = 0;            ///< candidates left out as obstacles (tables, ...)
   StairTimings timings;
+
+  /// Which way what was found goes from the user's floor: +1 up (ascending, single step, curb up),
+  /// -1 down (descending, curb down), 0 when nothing (not even a rejected candidate) was modelled.
+  /// A curb's kind does not say it: its level's height does.
+  int direction() const {
+    switch (kind) {
+      case StairKind::kAscending:
+      case StairKind::kSingleStep: return 1;
+      case StairKind::kDescending: return -1;
+      case StairKind::kCurb:
+        if (level_data.size() > 1 && level_data[1].height != 0.f) return level_data[1].height > 0.f ? 1 : -1;
+        return 0;
+      default: return 0;
+    }
+  }
 
   /// Centre of the first edge in the camera frame.
   Eigen::Vector3f origin() const { return T_camera_stair.translation(); }

@@ -30,6 +30,8 @@ std::string mat4(const Pose& T) {
   return o;
 }
 
+const char* direction_name(int d) { return d > 0 ? "up" : d < 0 ? "down" : "none"; }
+
 int detect(Context& ctx) {
   const bool json = ctx.flag("--json");
   const auto png = ctx.option("--png");
@@ -99,6 +101,8 @@ int detect(Context& ctx) {
     kv("stair", result.detected ? "true" : "false");
     kv("verdict", quote(to_string(result.verdict)));
     kv("kind", quote(to_string(result.kind)));
+    // The kind alone does not say which way a curb goes; a curb down taken for one up is a fall.
+    kv("direction", quote(direction_name(result.direction())));
     kv("levels", fmt(result.levels));
     kv("riser_m", fmt(result.riser_m));
     kv("tread_m", fmt(result.tread_m));
@@ -107,6 +111,7 @@ int detect(Context& ctx) {
     kv("edge_left", vec3(result.edge_left));
     kv("edge_right", vec3(result.edge_right));
     kv("method", quote(to_string(result.method)));
+    kv("without_floor", result.without_floor ? "true" : "false");
     kv("candidates", fmt(result.candidates));
     kv("rejected_candidates", fmt(result.rejected_candidates));
     kv("timings_ms", "{\"perception\": " + fmt(perception_ms) + ", \"detection\": " +
@@ -117,7 +122,8 @@ int detect(Context& ctx) {
       std::string stairs = "[";
       for (const auto& st : truth->stairs) {
         if (stairs.size() > 1) stairs += ", ";
-        stairs += "{\"kind\": " + quote(to_string(st.kind)) + ", \"riser_m\": " + fmt(st.riser_m) +
+        stairs += "{\"kind\": " + quote(to_string(st.kind)) + ", \"direction\": " +
+                  quote(st.goes_down() ? "down" : "up") + ", \"riser_m\": " + fmt(st.riser_m) +
                   ", \"tread_m\": " + fmt(st.tread_m) + ", \"width_m\": " + fmt(st.width_m) +
                   ", \"visible_steps\": " + fmt(static_cast<double>(st.visible_steps.size())) +
                   ", \"user_step\": " + fmt(st.user_step) + ", \"T_camera_stair\": " + mat4(st.T_camera_stair) + "}";
@@ -134,8 +140,8 @@ int detect(Context& ctx) {
   if (!scene.floor_found) std::printf("floor: not found (%s)\n", scene.why.c_str());
   if (result.detected) {
     const Eigen::Vector3f o = result.origin();
-    std::printf("stair: %s, %d levels seen, riser %.1f cm, tread %.1f cm, width %.1f cm, axes by %s\n",
-                to_string(result.kind), result.levels, 100.f * result.riser_m, 100.f * result.tread_m,
+    std::printf("stair: %s (%s), %d levels seen, riser %.1f cm, tread %.1f cm, width %.1f cm, axes by %s\n",
+                to_string(result.kind), direction_name(result.direction()), result.levels, 100.f * result.riser_m, 100.f * result.tread_m,
                 100.f * result.width_m, to_string(result.method));
     std::printf("first edge centre (camera frame): %.3f %.3f %.3f m\n", o.x(), o.y(), o.z());
   } else {

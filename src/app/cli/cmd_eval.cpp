@@ -145,9 +145,20 @@ bool run_csv(Runner& run, const std::string& path, const PipelineConfig& config,
     truth.scene = "real:" + (f[1] == "stair" ? (f.size() > 2 && !f[2].empty() ? f[2] : std::string("stair")) : "none");
     if (f[1] == "stair") {
       StairTruth s;
-      if (f.size() < 3 || !parse_stair_kind(f[2], s.kind) || s.kind == StairKind::kNone) {
-        error = path + ":" + std::to_string(line_no) + ": label 'stair' needs a kind (ascending, descending, ...)";
+      // A curb's kind does not say which way it goes: the file must (curb_up / curb_down).
+      const std::string kind = f.size() < 3 ? std::string() : f[2];
+      if (kind == "curb_up" || kind == "curb_down") {
+        s.kind = StairKind::kCurb;
+        s.down = kind == "curb_down";
+      } else if (kind == "curb") {
+        error = path + ":" + std::to_string(line_no) + ": kind 'curb' needs its direction: curb_up or curb_down";
         return false;
+      } else if (!parse_stair_kind(kind, s.kind) || s.kind == StairKind::kNone) {
+        error = path + ":" + std::to_string(line_no) +
+                ": label 'stair' needs a kind (ascending, descending, single_step, curb_up, curb_down)";
+        return false;
+      } else {
+        s.down = s.kind == StairKind::kDescending;
       }
       s.visible_steps = {1, 2};
       s.first_edge_visible = true;

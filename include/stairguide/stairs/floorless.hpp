@@ -1,0 +1,128 @@
+#pragma once
+/// \file floorless.hpp
+/// Stairs found when perception saw no floor (issue #4; paper 4.1, and the vertical of 5.2: "all
+/// step planes are used to compute the resulting normal as we can certainly say they are
+/// horizontal planes").
+///
+/// Standing at the foot of a staircase looking at the steps, on the staircase itself, or with the
+/// camera held level, the floor is out of view or outside the floor detector's chest-camera rules,
+/// so no height above the floor exists. This route takes the vertical from the horizontal planes
+/// themselves:
+///
+///  1. *Up*: every planar region whose normal (facing the camera) is plausible as "up" for a
+///     body-worn camera: roll within FloorConfig::roll_max, and the camera pitched between
+///     `floorless_tilt_min` (about level: a hand-held or level view, and the wobble of a chest
+///     camera while walking) and `floorless_tilt_max` (steeply down: the steps right in front of the
+///     feet). A ceiling or the underside of a board faces down (roll about 180 deg) and a wall
+///     ahead of a level camera lies at 90 deg pitch: neither passes. The largest family of
+///     parallel such planes (by pixels, within ClassificationConfig::parallel_threshold) gives the
+///     vertical, refitted to all of its points (each region centred on its own mean).
+///  2. *Levels*: the family's regions grouped by height (within `same_level_tolerance`) and by
+///     connectivity (Algorithm 1's test: `connection_min_points` within `connection_radius`);
+///     levels smaller than `floorless_min_level_pixels` are dropped.
+///  3. *Stack*: the longest chain of levels each one riser (H_min..H_max with `height_tolerance`)
+///     above the previous and connected to it; at least `floorless_min_levels`.
+///  4. *Direction*: ascending when the levels rise away from the camera (the near boundary of each
+///     higher level lies farther from the camera's vertical), descending when they rise towards
+///     it; a stack that does neither is no staircase.
+///  5. *Model*: the existing modelling (stair_modelling.hpp) on a pseudo floor frame built from the
+///     common normal, with a virtual level 0 one riser beyond the first seen level (below the
+///     lowest when ascending, above the highest when descending), so every seen level is a step
+///     with its own edge. Its building-code validation applies unchanged. Where the first seen
+///     level's edge is cut by the image border, its edge is not used: the tread then comes from the
+///     risers facing the user and the other edges, or stays unknown (0) when fewer than two edges
+///     are seen.
+///
+/// The result has `without_floor` set: heights are relative to the first seen level, and the
+/// distance from the user's feet (and whether that level is the first step) is unknown.
+///
+/// Pure: no I/O, no exceptions; buffers are kept between frames.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "stairguide/core/config.hpp"
+#include "stairguide/core/types.hpp"
+#include "stairguide/perception/scene.hpp"
+#include "stairguide/stairs/stair_detection.hpp"
+#include "stairguide/stairs/stair_modelling.hpp"
+#include "stairguide/stairs/stair_result.hpp"
+
+namespace stairguide {
+
+/// What the floorless route saw in the last frame (for tests and the CLI).
+struct FloorlessTrace {
+  bool up_found = false;               ///< a plausible family of horizontal planes was found
+  Eigen::Vector3f up = Eigen::Vector3f::Zero();  ///< camera frame, unit, pointing up
+  float tilt = 0.f, roll = 0.f;        ///< rad, camera pitch below horizontal and roll implied by `up`
+  int family_regions = 0;              ///< regions in the family
+  int levels = 0;                      ///< levels (height x connectivity groups) of the family
+  int stacked = 0;                     ///< levels in the longest stack one riser apart
+  int direction = 0;                   ///< +1 ascending, -1 descending, 0 undecided
+  bool floor_level = false;            ///< the lowest level was taken for the floor (deeper than a landing)
+  int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
+  std::vector<float> level_heights;    ///< m, up . p of each stacked level, lowest first
+};
+
+/// The floorless route. Pure: no I/O, no exceptions; buffers are kept between frames.
+class FloorlessStairs {
+ public:
+  FloorlessStairs(const ClassificationConfig& classification, const StairDetectionConfig& detection,
+                  const StairModellingConfig& modelling, const FloorConfig& floor);
+
+  /// Looks for a staircase in a frame without floor (scene.floor_found is not read: the caller
+  /// decides when to run it). Fills every field of `out` except the timings; `out.detected` says
+  /// whether a validated staircase was found, `out.without_floor` is always set. A frame with no
+  /// stack of levels gets verdict kNoFloor.
+  void run(const SceneResult& scene, const CameraIntrinsics* K, StairResult& out);
+
+  /// What the last run saw.
+  const FloorlessTrace& trace() const { return trace_; }
+
+ private:
+  struct Node {
+    std::vector<int> regions;             ///< indices into the input scene
+    float height = 0.f;                   ///< m, up . p, pixel-weighted
+    int pixels = 0;
+    std::vector<Eigen::Vector3f> sample;  ///< evenly subsampled points of all its regions
+    Eigen::Vector3f lo, hi;               ///< bounding box of the sample
+    int stride = 1;                       ///< points per sample point (largest over its regions)
+  };
+
+  bool find_up(const SceneResult& scene);
+  void build_nodes(const SceneResult& scene);
+  void add_to_node(const SceneResult& scene, int region, Node& node) const;
+  bool connected(const Node& a, const Node& b) const;
+  float near_distance(const Node& n);
+  /// Positions along z_S of the risers facing the user, by band (k: between levels k-1 and k;
+  /// n+1: above the top level), from the input scene; NaN where none.
+  void riser_positions(const SceneResult& scene, const StairResult& r, int n, float level0_plane);
+  /// Pseudo floor frame at `level0`, steps chain_[first..], modelling, edges refined.
+  void model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0, StairResult& out);
+  /// True when most of level k's edge line (at height y in the stair frame) lies on the image border.
+  bool edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const;
+  /// Tread and origin from the edges seen inside the image and the risers; validation again.
+  void refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+
+  ClassificationConfig cls_;
+  StairDetectionConfig det_;
+  StairModellingConfig mod_;
+  FloorConfig floor_;
+  StairModelling modelling_;
+  FloorlessTrace trace_;
+
+  std::vector<int> cand_;               ///< regions plausible as horizontal
+  std::vector<int> family_;             ///< regions of the family
+  std::vector<float> height_;           ///< per family member
+  std::vector<Node> nodes_;
+  std::vector<int> order_, best_len_, best_prev_, chain_;
+  std::vector<long> best_pix_;
+  std::vector<float> dist_, tmp_, riser_pos_, edge_k_, edge_e_;
+  std::vector<int> riser_n_;
+  std::vector<int> index_map_;          ///< pseudo-scene region -> input region
+  float level0_ = 0.f;                  ///< up . p of the virtual level 0 (camera frame), m
+  SceneResult pseudo_;                  ///< the pseudo floor frame and the regions modelling needs
+  StairHypothesis hyp_;
+};
+
+}  // namespace stairguide

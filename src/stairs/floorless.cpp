@@ -1,0 +1,642 @@
+#include "stairguide/stairs/floorless.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace stairguide {
+namespace {
+
+constexpr int kMinRegionPixels = 100;   // px, smaller regions have too noisy a normal to vote for up
+constexpr std::size_t kFitPoints = 500; // points per region in the fit of the common normal
+constexpr float kLandingDepth = 0.6f;   // m, a level deeper than this is a landing or a floor
+constexpr float kMinRise = 0.05f;       // m, a higher level's near boundary this much farther (nearer)
+                                        // than the lower one's says ascending (descending)
+
+float clampf(float x, float lo, float hi) { return std::min(hi, std::max(lo, x)); }
+
+/// Pitch below horizontal and roll of a camera whose "up" is `u` (camera frame: x right, y down,
+/// z forward).
+void tilt_roll(const Eigen::Vector3f& u, float& tilt, float& roll) {
+  tilt = std::asin(clampf(-u.z(), -1.f, 1.f));
+  roll = std::atan2(u.x(), -u.y());
+}
+
+void copy_region(const PlaneRegion& src, PlaneRegion& dst) {
+  // Everything modelling reads; the full-resolution pixel list is not needed and is the bulk.
+  dst.id = src.id;
+  dst.normal = src.normal;
+  dst.offset = src.offset;
+  dst.centroid = src.centroid;
+  dst.points.assign(src.points.begin(), src.points.end());
+  dst.pixels.clear();
+  dst.pixel_count = src.pixel_count;
+  dst.area = src.area;
+  dst.curvature = src.curvature;
+  dst.rect_center = src.rect_center;
+  dst.rect_axis_major = src.rect_axis_major;
+  dst.rect_axis_minor = src.rect_axis_minor;
+  dst.rect_length_major = src.rect_length_major;
+  dst.rect_length_minor = src.rect_length_minor;
+  dst.hull_extent = src.hull_extent;
+}
+
+}  // namespace
+
+FloorlessStairs::FloorlessStairs(const ClassificationConfig& classification, const StairDetectionConfig& detection,
+                                 const StairModellingConfig& modelling, const FloorConfig& floor)
+    : cls_(classification),
+      det_(detection),
+      mod_(modelling),
+      floor_(floor),
+      modelling_(classification, detection, modelling) {}
+
+bool FloorlessStairs::find_up(const SceneResult& scene) {
+  cand_.clear();
+  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
+    const PlaneRegion& r = scene.regions[i];
+    if (r.points.size() < 10 || r.pixel_count < kMinRegionPixels) continue;
+    float tilt = 0.f, roll = 0.f;
+    tilt_roll(r.normal, tilt, roll);
+    if (std::fabs(roll) > floor_.roll_max || tilt < det_.floorless_tilt_min || tilt > det_.floorless_tilt_max) continue;
+    cand_.push_back(static_cast<int>(i));
+  }
+  if (cand_.empty()) return false;
+  // The family with the most pixels: each plausible normal votes with the pixels of the regions
+  // parallel to it.
+  const float cos_par = std::cos(cls_.parallel_threshold);
+  long best_pix = -1;
+  int best = -1;
+  for (int c : cand_) {
+    const Eigen::Vector3f& nc = scene.regions[static_cast<std::size_t>(c)].normal;
+    long pix = 0;
+    for (int j : cand_)
+      if (nc.dot(scene.regions[static_cast<std::size_t>(j)].normal) >= cos_par)
+        pix += scene.regions[static_cast<std::size_t>(j)].pixel_count;
+    if (pix > best_pix) {
+      best_pix = pix;
+      best = c;
+    }
+  }
+  const Eigen::Vector3f n0 = scene.regions[static_cast<std::size_t>(best)].normal;
+  // The common normal of all the family's planes (paper 5.2): each region centred on its own mean,
+  // the direction of least spread of them all. One region's normal is noisy; the family's is not.
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  Eigen::Vector3f mean_normal = Eigen::Vector3f::Zero();
+  std::size_t total = 0;
+  for (int j : cand_) {
+    const PlaneRegion& r = scene.regions[static_cast<std::size_t>(j)];
+    if (n0.dot(r.normal) < cos_par) continue;
+    mean_normal += r.normal * static_cast<float>(r.pixel_count);
+    const std::size_t stride = std::max<std::size_t>(1, r.points.size() / kFitPoints);
+    Eigen::Vector3d m = Eigen::Vector3d::Zero();
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < r.points.size(); i += stride, ++n) m += r.points[i].cast<double>();
+    m /= static_cast<double>(n);
+    for (std::size_t i = 0; i < r.points.size(); i += stride) {
+      const Eigen::Vector3d d = r.points[i].cast<double>() - m;
+      scatter += d * d.transpose();
+    }
+    total += n;
+  }
+  Eigen::Vector3f up = mean_normal.normalized();
+  if (total >= 50) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(scatter);
+    Eigen::Vector3f fit = es.eigenvectors().col(0).cast<float>().normalized();
+    if (fit.dot(up) < 0.f) fit = -fit;
+    // A fit far from the normals means the family is not one set of parallel planes.
+    if (fit.dot(up) >= std::cos(deg2rad(3.f))) up = fit;
+  }
+  family_.clear();
+  for (int j : cand_)
+    if (up.dot(scene.regions[static_cast<std::size_t>(j)].normal) >= cos_par) family_.push_back(j);
+  trace_.up = up;
+  tilt_roll(up, trace_.tilt, trace_.roll);
+  trace_.family_regions = static_cast<int>(family_.size());
+  if (std::fabs(trace_.roll) > floor_.roll_max || trace_.tilt < det_.floorless_tilt_min ||
+      trace_.tilt > det_.floorless_tilt_max || family_.empty())
+    return false;
+  trace_.up_found = true;
+  return true;
+}
+
+void FloorlessStairs::add_to_node(const SceneResult& scene, int region, Node& node) const {
+  const PlaneRegion& r = scene.regions[static_cast<std::size_t>(region)];
+  const std::size_t n = r.points.size();
+  const std::size_t cap = static_cast<std::size_t>(std::max(1, det_.connection_max_points));
+  // An even stride keeps the sample spread over the region, as the neighbour test needs; the
+  // required count is scaled by the stride so "10 points" keeps its meaning.
+  const int stride = std::max(1, static_cast<int>((n + cap - 1) / cap));
+  node.stride = std::max(node.stride, stride);
+  for (std::size_t i = 0; i < n; i += static_cast<std::size_t>(stride)) {
+    node.sample.push_back(r.points[i]);
+    node.lo = node.lo.cwiseMin(r.points[i]);
+    node.hi = node.hi.cwiseMax(r.points[i]);
+  }
+  node.regions.push_back(region);
+}
+
+bool FloorlessStairs::connected(const Node& a, const Node& b) const {
+  const float rad = det_.connection_radius, r2 = rad * rad;
+  const int need = std::max(1, (det_.connection_min_points + a.stride - 1) / a.stride);
+  const Eigen::Vector3f gap = (b.lo - a.hi).cwiseMax(a.lo - b.hi).cwiseMax(Eigen::Vector3f::Zero());
+  if (gap.squaredNorm() > r2) return false;
+  const Eigen::Vector3f blo = b.lo.array() - rad, bhi = b.hi.array() + rad;
+  int found = 0;
+  for (const Eigen::Vector3f& p : a.sample) {
+    if ((p.array() < blo.array()).any() || (p.array() > bhi.array()).any()) continue;
+    for (const Eigen::Vector3f& q : b.sample) {
+      if ((p - q).squaredNorm() <= r2) {
+        if (++found >= need) return true;
+        break;
+      }
+    }
+  }
+  return false;
+}
+
+void FloorlessStairs::build_nodes(const SceneResult& scene) {
+  const Eigen::Vector3f up = trace_.up;
+  height_.resize(family_.size());
+  for (std::size_t i = 0; i < family_.size(); ++i)
+    height_[i] = up.dot(scene.regions[static_cast<std::size_t>(family_[i])].centroid);
+  order_.resize(family_.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) { return height_[static_cast<std::size_t>(a)] < height_[static_cast<std::size_t>(b)]; });
+
+  std::size_t used = 0;
+  auto new_node = [&]() -> Node& {
+    if (used >= nodes_.size()) nodes_.emplace_back();
+    Node& n = nodes_[used++];
+    n.regions.clear();
+    n.sample.clear();
+    n.height = 0.f;
+    n.pixels = 0;
+    n.stride = 1;
+    n.lo.setConstant(std::numeric_limits<float>::max());
+    n.hi.setConstant(-std::numeric_limits<float>::max());
+    return n;
+  };
+  // Heights within the same-level tolerance of a cluster's running mean form one height cluster;
+  // inside it, regions joined by connectivity (Algorithm 1's test) form one level. A table top at
+  // a tread's height across the room is a level of its own.
+  std::size_t i = 0;
+  while (i < order_.size()) {
+    std::size_t j = i + 1;
+    double sum_h = height_[static_cast<std::size_t>(order_[i])];
+    long sum_w = 1;
+    {
+      const int px = scene.regions[static_cast<std::size_t>(family_[static_cast<std::size_t>(order_[i])])].pixel_count;
+      sum_h *= px;
+      sum_w = px;
+    }
+    while (j < order_.size()) {
+      const std::size_t m = static_cast<std::size_t>(order_[j]);
+      if (height_[m] - static_cast<float>(sum_h / static_cast<double>(sum_w)) > det_.same_level_tolerance) break;
+      const int px = scene.regions[static_cast<std::size_t>(family_[m])].pixel_count;
+      sum_h += static_cast<double>(height_[m]) * px;
+      sum_w += px;
+      ++j;
+    }
+    // One node per region of the cluster, then merged while any two are connected.
+    const std::size_t first = used;
+    for (std::size_t k = i; k < j; ++k) {
+      const std::size_t m = static_cast<std::size_t>(order_[k]);
+      Node& n = new_node();
+      add_to_node(scene, family_[m], n);
+      n.pixels = scene.regions[static_cast<std::size_t>(family_[m])].pixel_count;
+      n.height = height_[m];
+    }
+    bool merged = true;
+    while (merged) {
+      merged = false;
+      for (std::size_t a = first; a < used && !merged; ++a) {
+        for (std::size_t b = a + 1; b < used && !merged; ++b) {
+          if (!connected(nodes_[a], nodes_[b]) && !connected(nodes_[b], nodes_[a])) continue;
+          Node& A = nodes_[a];
+          Node& B = nodes_[b];
+          A.height = (A.height * static_cast<float>(A.pixels) + B.height * static_cast<float>(B.pixels)) /
+                     static_cast<float>(A.pixels + B.pixels);
+          A.pixels += B.pixels;
+          A.regions.insert(A.regions.end(), B.regions.begin(), B.regions.end());
+          A.sample.insert(A.sample.end(), B.sample.begin(), B.sample.end());
+          A.lo = A.lo.cwiseMin(B.lo);
+          A.hi = A.hi.cwiseMax(B.hi);
+          A.stride = std::max(A.stride, B.stride);
+          std::swap(nodes_[b], nodes_[used - 1]);
+          --used;
+          merged = true;
+        }
+      }
+    }
+    i = j;
+  }
+  // Levels too small to be a tread seen in part are left out (a box top, a book).
+  std::size_t keep = 0;
+  for (std::size_t k = 0; k < used; ++k) {
+    if (nodes_[k].pixels < det_.floorless_min_level_pixels) continue;
+    if (k != keep) std::swap(nodes_[k], nodes_[keep]);
+    ++keep;
+  }
+  order_.resize(keep);
+  std::iota(order_.begin(), order_.end(), 0);
+  std::sort(order_.begin(), order_.end(),
+            [&](int a, int b) { return nodes_[static_cast<std::size_t>(a)].height < nodes_[static_cast<std::size_t>(b)].height; });
+  trace_.levels = static_cast<int>(keep);
+}
+
+float FloorlessStairs::near_distance(const Node& n) {
+  // Distance from the camera's vertical of the level's nearest points (a low quantile: a few
+  // strays do not count).
+  const Eigen::Vector3f up = trace_.up;
+  dist_.clear();
+  for (const auto& p : n.sample) dist_.push_back((p - up * up.dot(p)).norm());
+  if (dist_.empty()) return 0.f;
+  const std::size_t i = dist_.size() / 20;
+  std::nth_element(dist_.begin(), dist_.begin() + static_cast<long>(i), dist_.end());
+  return dist_[i];
+}
+
+void FloorlessStairs::riser_positions(const SceneResult& scene, const StairResult& r, int n, float level0_plane) {
+  // Vertical regions facing the user, between two consecutive levels (k: below level k) or above
+  // the top one (n + 1), within the staircase's lateral span: where each step starts.
+  riser_pos_.assign(static_cast<std::size_t>(n + 2), std::numeric_limits<float>::quiet_NaN());
+  riser_n_.assign(static_cast<std::size_t>(n + 2), 0);
+  const Eigen::Vector3f xs = r.T_camera_stair.linear().col(0), up = r.T_camera_stair.linear().col(1),
+                        zs = r.T_camera_stair.linear().col(2);
+  const Eigen::Vector3f o = r.T_camera_stair.translation();
+  const float sin_vert = std::sin(cls_.parallel_threshold), cos_face = std::cos(cls_.parallel_threshold);
+  const float half = 0.5f * r.width_m;
+  for (const PlaneRegion& reg : scene.regions) {
+    if (reg.points.size() < 40 || std::fabs(reg.normal.dot(up)) > sin_vert || std::fabs(reg.normal.dot(zs)) < cos_face)
+      continue;
+    const std::size_t stride = std::max<std::size_t>(1, reg.points.size() / 300);
+    tmp_.clear();
+    dist_.clear();
+    float a_sum = 0.f;
+    std::size_t cnt = 0;
+    for (std::size_t i = 0; i < reg.points.size(); i += stride, ++cnt) {
+      const Eigen::Vector3f d = reg.points[i] - o;
+      tmp_.push_back(up.dot(reg.points[i]) - level0_plane);
+      dist_.push_back(zs.dot(d));
+      a_sum += xs.dot(d);
+    }
+    const float a_mid = a_sum / static_cast<float>(cnt);
+    if (a_mid < -half || a_mid > half) continue;  // beside the staircase
+    std::sort(tmp_.begin(), tmp_.end());
+    const float h_lo = tmp_[tmp_.size() / 10], h_hi = tmp_[tmp_.size() * 9 / 10];
+    int band = 0;
+    for (int k = 1; k <= n + 1; ++k) {
+      const float below = k == 1 ? 0.f : r.level_data[static_cast<std::size_t>(k - 1)].height;
+      const float above = k <= n ? r.level_data[static_cast<std::size_t>(k)].height : below + r.riser_m;
+      if (h_lo >= below - 0.03f && h_hi <= above + 0.03f && h_hi - h_lo >= 0.3f * (above - below)) band = k;
+    }
+    if (band == 0) continue;
+    const auto mid = dist_.begin() + static_cast<long>(dist_.size() / 2);
+    std::nth_element(dist_.begin(), mid, dist_.end());
+    if (static_cast<int>(reg.points.size()) > riser_n_[static_cast<std::size_t>(band)]) {
+      riser_n_[static_cast<std::size_t>(band)] = static_cast<int>(reg.points.size());
+      riser_pos_[static_cast<std::size_t>(band)] = *mid;
+    }
+  }
+}
+
+void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, StairResult& out) {
+  trace_ = FloorlessTrace{};
+  out.detected = false;
+  out.verdict = StairVerdict::kNoFloor;
+  out.kind = StairKind::kNone;
+  out.levels = 0;
+  out.riser_m = out.tread_m = out.width_m = 0.f;
+  out.width_complete = false;
+  out.T_camera_stair = Pose::Identity();
+  out.edge_left.setZero();
+  out.edge_right.setZero();
+  out.method = StairAxesMethod::kNone;
+  out.without_floor = true;
+  out.level_data.clear();
+  out.candidates = out.rejected_candidates = 0;
+  if (!find_up(scene)) return;
+  build_nodes(scene);
+  const std::size_t m = order_.size();
+  out.candidates = static_cast<int>(m);
+  out.rejected_candidates = static_cast<int>(m);
+  if (m < 2) return;
+
+  // ---- the longest stack of levels one riser apart, each connected to the one below ----
+  const float hmin = cls_.step_height_min - det_.height_tolerance;
+  const float hmax = cls_.step_height_max + det_.height_tolerance;
+  best_len_.assign(m, 1);
+  best_prev_.assign(m, -1);
+  best_pix_.assign(m, 0);
+  for (std::size_t j = 0; j < m; ++j) {
+    const Node& b = nodes_[static_cast<std::size_t>(order_[j])];
+    best_pix_[j] = b.pixels;
+    for (std::size_t i = 0; i < j; ++i) {
+      const Node& a = nodes_[static_cast<std::size_t>(order_[i])];
+      const float dh = b.height - a.height;
+      if (dh < hmin || dh > hmax) continue;
+      const int len = best_len_[i] + 1;
+      const long pix = best_pix_[i] + b.pixels;
+      if (len < best_len_[j] || (len == best_len_[j] && pix <= best_pix_[j])) continue;
+      if (!connected(b, a) && !connected(a, b)) continue;
+      best_len_[j] = len;
+      best_pix_[j] = pix;
+      best_prev_[j] = static_cast<int>(i);
+    }
+  }
+  std::size_t end = 0;
+  for (std::size_t j = 1; j < m; ++j)
+    if (best_len_[j] > best_len_[end] || (best_len_[j] == best_len_[end] && best_pix_[j] > best_pix_[end])) end = j;
+  chain_.clear();
+  for (int j = static_cast<int>(end); j >= 0; j = best_prev_[static_cast<std::size_t>(j)]) chain_.push_back(order_[static_cast<std::size_t>(j)]);
+  std::reverse(chain_.begin(), chain_.end());  // lowest first
+  trace_.stacked = static_cast<int>(chain_.size());
+  for (int c : chain_) trace_.level_heights.push_back(nodes_[static_cast<std::size_t>(c)].height);
+  if (static_cast<int>(chain_.size()) < std::max(2, det_.floorless_min_levels)) return;
+
+  // ---- direction: do the levels rise away from the camera or towards it? ----
+  int votes_up = 0, votes_down = 0;
+  float prev = near_distance(nodes_[static_cast<std::size_t>(chain_[0])]);
+  for (std::size_t k = 1; k < chain_.size(); ++k) {
+    const float d = near_distance(nodes_[static_cast<std::size_t>(chain_[k])]);
+    if (d > prev + kMinRise) ++votes_up;
+    else if (d < prev - kMinRise) ++votes_down;
+    prev = d;
+  }
+  const int n = static_cast<int>(chain_.size());
+  int dir = 0;
+  if (votes_up == n - 1) dir = 1;
+  if (votes_down == n - 1) dir = -1;
+  trace_.direction = dir;
+  out.kind = StairKind::kNone;
+  out.levels = n;
+  if (dir == 0) {
+    out.verdict = StairVerdict::kInconsistentEdges;
+    return;
+  }
+
+  // ---- pseudo floor frame: the common normal, a virtual level 0 one riser beyond the first ----
+  // Seen levels in stair order (ascending: lowest first; descending: highest first), their heights
+  // fitted against the index; the virtual level sits where that line meets index 0, so it adds
+  // nothing to modelling's fit of the riser.
+  if (dir < 0) std::reverse(chain_.begin(), chain_.end());
+  double sk = 0, sh = 0, skk = 0, skh = 0;
+  for (int k = 1; k <= n; ++k) {
+    const double h = nodes_[static_cast<std::size_t>(chain_[static_cast<std::size_t>(k - 1)])].height;
+    sk += k;
+    sh += h;
+    skk += static_cast<double>(k) * k;
+    skh += k * h;
+  }
+  const double slope = (n * skh - sk * sh) / (n * skk - sk * sk);
+  const float level0 = static_cast<float>((sh - slope * sk) / n);
+  model(scene, K, dir, 0, level0, out);
+  // Ascending, a lowest level deeper than a landing is the floor the user stands on (seen, but
+  // refused by the floor detector, e.g. a level camera): it becomes level 0 at its own height and
+  // the treads above it are the steps, so the first edge is the first tread's.
+  if (dir > 0 && out.level_data.size() > 1 && out.level_data[1].depth_max - out.level_data[1].depth_min > kLandingDepth) {
+    trace_.floor_level = true;
+    if (n - 1 < std::max(2, det_.floorless_min_levels)) {
+      // A floor and one level on it: the single-level case needs the real floor (paper 4.1).
+      out.detected = false;
+      out.verdict = StairVerdict::kNoFloor;
+      out.levels = n - 1;
+      return;
+    }
+    model(scene, K, dir, 1, nodes_[static_cast<std::size_t>(chain_[0])].height, out);
+  }
+}
+
+void FloorlessStairs::model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0,
+                            StairResult& out) {
+  // Steps are chain_[first..] in stair order; level 0 is virtual, at `level0` (up . p).
+  const std::size_t m = order_.size();
+  const int n = static_cast<int>(chain_.size()) - first;
+  level0_ = level0;
+  const Eigen::Vector3f up = trace_.up;
+  Eigen::Vector3f fwd = Eigen::Vector3f::UnitZ() - up * up.z();
+  if (fwd.norm() < 1e-3f) fwd = -Eigen::Vector3f::UnitY() - up * (-up.y());
+  fwd.normalize();
+  const Eigen::Vector3f left = up.cross(fwd).normalized();
+  pseudo_.floor_found = true;
+  pseudo_.why.clear();
+  pseudo_.T_floor_camera.setIdentity();
+  pseudo_.T_floor_camera.linear().row(0) = left.transpose();
+  pseudo_.T_floor_camera.linear().row(1) = up.transpose();
+  pseudo_.T_floor_camera.linear().row(2) = fwd.transpose();
+  pseudo_.T_floor_camera.translation() = Eigen::Vector3f(0.f, -level0, 0.f);
+  pseudo_.camera_height = -level0;
+  pseudo_.camera_tilt = trace_.tilt;
+  pseudo_.camera_roll = trace_.roll;
+  pseudo_.floor_region = -1;
+  pseudo_.manhattan_found = false;  // the Manhattan frame hangs on the floor: the steps' own axes
+  pseudo_.T_manhattan_floor.setIdentity();
+  pseudo_.manhattan_yaw = pseudo_.manhattan_fraction = 0.f;
+  pseudo_.clusters.clear();
+
+  // Only the regions modelling reads: the stacked levels' and the vertical ones (risers).
+  index_map_.clear();
+  std::size_t used = 0;
+  auto take = [&](int region, RegionClass cls) {
+    if (used >= pseudo_.regions.size()) pseudo_.regions.emplace_back();
+    PlaneRegion& dst = pseudo_.regions[used++];
+    const PlaneRegion& src = scene.regions[static_cast<std::size_t>(region)];
+    copy_region(src, dst);
+    dst.cls = cls;
+    dst.height = up.dot(src.centroid) - level0;
+    index_map_.push_back(region);
+    return static_cast<int>(used - 1);
+  };
+  hyp_.direction = dir;
+  hyp_.verdict = StairVerdict::kDetected;
+  hyp_.candidates = static_cast<int>(m);
+  hyp_.rejected = static_cast<int>(m) - n;
+  hyp_.levels.resize(static_cast<std::size_t>(n + 1));
+  hyp_.levels[0].index = 0;
+  hyp_.levels[0].height = 0.f;
+  hyp_.levels[0].point_count = 0;
+  hyp_.levels[0].regions.clear();
+  for (int k = 1; k <= n; ++k) {
+    const Node& node = nodes_[static_cast<std::size_t>(chain_[static_cast<std::size_t>(k - 1 + first)])];
+    LevelSeed& l = hyp_.levels[static_cast<std::size_t>(k)];
+    l.index = k;
+    l.height = node.height - level0;
+    l.point_count = node.pixels;
+    l.regions.clear();
+    for (int r : node.regions) l.regions.push_back(take(r, RegionClass::kStepCandidate));
+  }
+  const float sin_vert = std::sin(cls_.parallel_threshold);
+  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
+    const PlaneRegion& r = scene.regions[i];
+    if (r.points.size() >= 40 && std::fabs(r.normal.dot(up)) <= sin_vert) take(static_cast<int>(i), RegionClass::kVertical);
+  }
+  pseudo_.regions.resize(used);
+
+  modelling_.run(pseudo_, hyp_, out, K);
+  out.without_floor = true;
+  out.candidates = static_cast<int>(m);
+  out.rejected_candidates = hyp_.rejected;
+  for (auto& l : out.level_data)
+    for (int& r : l.regions) r = index_map_[static_cast<std::size_t>(r)];
+  refine_edges(scene, K, dir, n, out);
+}
+
+bool FloorlessStairs::edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const {
+  // Samples along the level's edge line: where most lie on (or beyond) the image border, the edge
+  // is where the view ends, not where the level does.
+  const StairLevel& l = r.level_data[static_cast<std::size_t>(k)];
+  const float margin = 0.03f * static_cast<float>(std::max(K.width, K.height));
+  int cut = 0;
+  constexpr int kSamples = 9;
+  for (int i = 0; i < kSamples; ++i) {
+    const float a = l.lateral_min + (l.lateral_max - l.lateral_min) * (static_cast<float>(i) + 0.5f) / kSamples;
+    const Eigen::Vector3f p = r.T_camera_stair * Eigen::Vector3f(a, y, l.edge);
+    if (p.z() < 0.05f) {
+      ++cut;
+      continue;
+    }
+    const float u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
+    if (u < margin || v < margin || u > static_cast<float>(K.width) - margin || v > static_cast<float>(K.height) - margin)
+      ++cut;
+  }
+  return 2 * cut >= kSamples;
+}
+
+void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out) {
+  // Modelling measured each level's step edge from its points. Without a floor the first seen
+  // level often runs out of the image (the tread under the camera, or the floor itself when the
+  // floor detector refused it), and its "edge" is then the image border: the tread and the origin
+  // would follow it. Only edges seen inside the image are used here, with the risers facing the
+  // user (ascending), including the one above the top level, which modelling does not use.
+  const StairVerdict v = out.verdict;
+  const bool refit = v == StairVerdict::kDetected || v == StairVerdict::kTreadTooShort ||
+                     v == StairVerdict::kBlondelOutOfRange || v == StairVerdict::kInconsistentEdges;
+  if (!refit || static_cast<int>(out.level_data.size()) != n + 1) return;
+  const float y_origin = dir > 0 ? out.level_data[1].height : 0.f;
+  edge_k_.clear();
+  edge_e_.clear();
+  if (dir > 0) {
+    riser_positions(scene, out, n, level0_);
+  } else {
+    riser_pos_.assign(static_cast<std::size_t>(n + 2), std::numeric_limits<float>::quiet_NaN());
+  }
+  // Nosing: the tread edge's offset from its riser where both are seen and agree.
+  tmp_.clear();
+  for (int k = 1; k <= n; ++k) {
+    const float d = out.level_data[static_cast<std::size_t>(k)].edge - riser_pos_[static_cast<std::size_t>(k)];
+    const bool seen = !K || !edge_cut(*K, out, k, out.level_data[static_cast<std::size_t>(k)].height - y_origin);
+    if (seen && std::isfinite(d) && d >= -0.02f && d <= 0.05f) tmp_.push_back(d);
+  }
+  float nosing = 0.f;
+  if (!tmp_.empty()) {
+    std::sort(tmp_.begin(), tmp_.end());
+    nosing = tmp_[tmp_.size() / 2];
+  }
+  const int last = dir > 0 ? n + 1 : n;
+  for (int k = 1; k <= last; ++k) {
+    const float rk = riser_pos_[static_cast<std::size_t>(k)];
+    float e = std::numeric_limits<float>::quiet_NaN();
+    if (std::isfinite(rk)) {
+      e = rk + nosing;
+    } else if (k <= n) {
+      const StairLevel& l = out.level_data[static_cast<std::size_t>(k)];
+      // The lowest level of an ascending stack deeper than a landing is the floor (or a landing)
+      // seen from on it: its near side is the user's side, no step edge.
+      const bool floor_like = dir > 0 && k == 1 && l.depth_max - l.depth_min > kLandingDepth;
+      if (!floor_like && (!K || !edge_cut(*K, out, k, l.height - y_origin))) e = l.edge;
+    }
+    if (!std::isfinite(e)) continue;
+    edge_k_.push_back(static_cast<float>(k));
+    edge_e_.push_back(e);
+  }
+  trace_.edges_seen = static_cast<int>(edge_k_.size());
+  float shift = 0.f;  // new origin along z_S, in the current stair frame
+  if (edge_k_.size() >= 2) {
+    // Consensus, as modelling does: the line through two edges that most edges lie near (within
+    // edge_max_residual), refitted to those; two thirds of the edges must agree.
+    const std::size_t q = edge_k_.size();
+    std::size_t best_in = 0;
+    float best_res = std::numeric_limits<float>::max(), best_slope = 0.f, best_icpt = 0.f;
+    for (std::size_t i = 0; i < q; ++i) {
+      for (std::size_t j = i + 1; j < q; ++j) {
+        const float sl = (edge_e_[j] - edge_e_[i]) / (edge_k_[j] - edge_k_[i]);
+        const float ic = edge_e_[i] - sl * edge_k_[i];
+        std::size_t in = 0;
+        float res = 0.f;
+        for (std::size_t k = 0; k < q; ++k) {
+          const float d = std::fabs(edge_e_[k] - (ic + sl * edge_k_[k]));
+          if (d <= mod_.edge_max_residual) {
+            ++in;
+            res += d;
+          }
+        }
+        if (in > best_in || (in == best_in && res < best_res)) {
+          best_in = in;
+          best_res = res;
+          best_slope = sl;
+          best_icpt = ic;
+        }
+      }
+    }
+    double sk = 0, se = 0, skk = 0, ske = 0, cnt = 0;
+    for (std::size_t i = 0; i < q; ++i) {
+      if (std::fabs(edge_e_[i] - (best_icpt + best_slope * edge_k_[i])) > mod_.edge_max_residual) continue;
+      sk += edge_k_[i];
+      se += edge_e_[i];
+      skk += static_cast<double>(edge_k_[i]) * edge_k_[i];
+      ske += static_cast<double>(edge_k_[i]) * edge_e_[i];
+      cnt += 1;
+    }
+    const double den = cnt * skk - sk * sk;
+    const float slope = std::fabs(den) > 1e-9 ? static_cast<float>((cnt * ske - sk * se) / den) : best_slope;
+    const float icpt = std::fabs(den) > 1e-9 ? static_cast<float>((se - slope * sk) / cnt) : best_icpt;
+    out.tread_m = slope;
+    shift = dir > 0 ? icpt + slope : icpt;
+    if (best_in < 2 || 3 * best_in < 2 * q) {
+      out.detected = false;
+      out.verdict = StairVerdict::kInconsistentEdges;
+      return;
+    }
+  } else {
+    // One edge or none seen: the tread is unknown. The origin stays on the first level's seen
+    // boundary unless its edge is seen.
+    out.tread_m = 0.f;
+    if (edge_k_.size() == 1 && edge_k_[0] == 1.f) shift = edge_e_[0];
+  }
+  if (shift != 0.f) {
+    const Eigen::Vector3f zs = out.T_camera_stair.linear().col(2);
+    out.T_camera_stair.translation() += zs * shift;
+    out.edge_left += zs * shift;
+    out.edge_right += zs * shift;
+    for (int k = 1; k <= n; ++k) {
+      StairLevel& l = out.level_data[static_cast<std::size_t>(k)];
+      l.edge -= shift;
+      l.depth_min -= shift;
+      l.depth_max -= shift;
+    }
+  }
+  // Validation again, as modelling does, with the tread from the seen edges (none when unknown).
+  const float tol = mod_.dimension_tolerance;
+  const float range = out.T_camera_stair.translation().norm();
+  const float tread_tol = tol + mod_.tread_tolerance_per_m2 * range * range;
+  const float riser = out.riser_m, tread = out.tread_m;
+  out.detected = false;
+  if (riser < mod_.riser_min - tol || riser > mod_.riser_max + tol)
+    out.verdict = StairVerdict::kRiserOutOfRange;
+  else if (edge_k_.size() >= 2 && tread < mod_.tread_min - tread_tol)
+    out.verdict = StairVerdict::kTreadTooShort;
+  else if (edge_k_.size() >= 2 &&
+           (2.f * riser + tread < mod_.blondel_min - tread_tol || 2.f * riser + tread > mod_.blondel_max + tread_tol))
+    out.verdict = StairVerdict::kBlondelOutOfRange;
+  else if (out.width_m < (out.width_complete ? mod_.width_min : 0.5f * mod_.width_min) - tol)
+    out.verdict = StairVerdict::kTooNarrow;
+  else {
+    out.verdict = StairVerdict::kDetected;
+    out.detected = true;
+  }
+}
+
+}  // namespace stairguide
