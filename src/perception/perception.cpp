@@ -46,6 +46,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.T_floor_camera = Pose::Identity();
   out.camera_height = out.camera_tilt = out.camera_roll = 0.f;
   out.floor_region = -1;
+  out.remembered_camera_height = 0.f;
+  out.frames_since_floor = -1;
   out.manhattan_found = false;
   out.T_manhattan_floor = Pose::Identity();
   out.manhattan_yaw = out.manhattan_fraction = 0.f;
@@ -62,6 +64,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   }
 
   floor_est_ = floor_.detect(out.regions, frame);
+  out.remembered_camera_height = floor_.remembered_height();
+  out.frames_since_floor = floor_.frames_since_floor();
   const auto t2 = Clock::now();
   out.timings.floor_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   if (floor_est_.found) {

@@ -68,6 +68,10 @@ class FloorDetector {
     lost_frames_ = 0;
   }
   const FloorConfig& config() const { return cfg_; }
+  /// Camera height above the floor last verified on a clear view, while remembered; 0 when unknown.
+  float remembered_height() const { return anchor_ ? *anchor_ : 0.f; }
+  /// Frames since the floor was last found; -1 when no floor is remembered.
+  int frames_since_floor() const { return prev_ ? lost_frames_ : -1; }
 
  private:
   int choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k, bool& tracked);

@@ -70,6 +70,12 @@ struct SceneResult {
   float camera_tilt = 0.f;                ///< rad, optical axis below horizontal
   float camera_roll = 0.f;                ///< rad
   int floor_region = -1;                  ///< index into regions, -1 when the floor is not a region
+  /// m, the camera's height above the user's feet as last measured on a floor that passed every
+  /// check, while it is remembered (FloorConfig::track_forget_frames), also on frames where no
+  /// floor is found; 0 when unknown. A property of the wearer, not of the place: with the floor
+  /// out of view (at the foot of a staircase) it still says where the user's feet are.
+  float remembered_camera_height = 0.f;
+  int frames_since_floor = -1;            ///< frames since the floor was last found; -1 never (or forgotten)
 
   bool manhattan_found = false;
   Pose T_manhattan_floor = Pose::Identity();  ///< floor frame into Manhattan frame M (rotation about y)
