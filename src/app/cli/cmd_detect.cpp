@@ -51,7 +51,16 @@ int detect(Context& ctx) {
                  source->describe().c_str(), source->frame_count());
     return 2;
   }
+  // As in `analyze`: frames before N go through perception too, so that the floor tracking (and
+  // the camera height it remembers) sees the same history as in a live run; unless the source's
+  // frames are unrelated views.
+  Perception perception(ctx.config);
+  StairStage stage(ctx.config);
+  SceneResult scene;
+  StairResult result;
   RgbdFrame frame;
+  const bool independent = source->independent_frames();
+  auto t0 = std::chrono::steady_clock::now(), t1 = t0;
   for (long i = 0; i <= frame_no; ++i) {
     const ReadResult rr = source->read(frame);
     if (!rr.ok()) {
@@ -59,15 +68,11 @@ int detect(Context& ctx) {
                    rr.message.empty() ? "end of input" : rr.message.c_str());
       return 1;
     }
+    if (independent && i < frame_no) continue;
+    t0 = std::chrono::steady_clock::now();
+    perception.process(frame, scene);
+    t1 = std::chrono::steady_clock::now();
   }
-
-  Perception perception(ctx.config);
-  StairStage stage(ctx.config);
-  SceneResult scene;
-  StairResult result;
-  const auto t0 = std::chrono::steady_clock::now();
-  perception.process(frame, scene);
-  const auto t1 = std::chrono::steady_clock::now();
   stage.run(scene, frame.intrinsics, result);
   const double perception_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   const auto truth = source->truth();
