@@ -2,6 +2,7 @@
 // known dimensions sampled with depth noise, tables, shelves, boxes, curbs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -275,6 +276,168 @@ TEST(StairsUnit, FirstStepMustTouchTheFloor) {
   stage.run(b.scene, r);
   EXPECT_FALSE(r.detected);
   EXPECT_EQ(r.verdict, StairVerdict::kNoFirstStep);
+}
+
+// ---- the top of a descent: floor only beside the stairwell, first treads under the view ----
+
+/// Drops every point below the image row y/z = v_max (the bottom of a camera's view), refits the
+/// regions' centroids and offsets, and removes regions left with too few points.
+void cut_view(SceneResult& scene, float v_max) {
+  std::vector<PlaneRegion> kept;
+  int floor_region = -1;
+  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
+    PlaneRegion r = scene.regions[i];
+    r.points.erase(std::remove_if(r.points.begin(), r.points.end(),
+                                  [&](const Eigen::Vector3f& p) { return p.y() / p.z() > v_max; }),
+                   r.points.end());
+    if (r.points.size() < 10) continue;
+    Eigen::Vector3f c = Eigen::Vector3f::Zero();
+    for (const auto& p : r.points) c += p;
+    r.centroid = c / static_cast<float>(r.points.size());
+    r.pixel_count = static_cast<int>(r.points.size());
+    r.offset = -r.normal.dot(r.centroid);
+    if (static_cast<int>(i) == scene.floor_region) floor_region = static_cast<int>(kept.size());
+    kept.push_back(std::move(r));
+  }
+  scene.regions = std::move(kept);
+  scene.floor_region = floor_region;
+}
+
+/// Moves a region down by `drop` (m) along the floor's up.
+void lower_region(SceneResult& scene, PlaneRegion& r, float drop) {
+  const Eigen::Vector3f up = scene.T_floor_camera.linear().row(1).transpose();
+  for (auto& p : r.points) p -= up * drop;
+  r.centroid -= up * drop;
+  r.offset = -r.normal.dot(r.centroid);
+  r.height -= drop;
+}
+
+/// A descending flight straight ahead whose first edge lies `distance` in front of the camera's
+/// foot, the floor in front of it and the floor beside the stairwell (1.2 m on each side), seen by
+/// a 1.3 m high camera tilted 45 deg with a 45 deg vertical field of view: the view starts 0.54 m
+/// in front of the feet on the floor, deeper on the treads.
+SceneBuilder top_of_descent(float distance, unsigned seed) {
+  SceneBuilder b(1.3f, 45.f, seed);
+  StairSpec s;
+  s.direction = -1;
+  s.steps = 6;
+  s.riser = 0.17f;
+  s.tread = 0.29f;
+  s.width = 1.2f;
+  s.distance = distance;
+  s.yaw_deg = 0.f;
+  b.add_stairs(s);
+  const int front = b.scene.floor_region;
+  b.add_box_top(1.2f, distance + 1.5f, 1.2f, 3.0f, 0.f, RegionClass::kFloor);
+  b.add_box_top(-1.2f, distance + 1.5f, 1.2f, 3.0f, 0.f, RegionClass::kFloor);
+  b.scene.floor_region = front;
+  cut_view(b.scene, std::tan(deg2rad(22.5f)));
+  // The floor in front of the edge may be out of view: the floor is then the one beside.
+  if (b.scene.floor_region < 0)
+    for (std::size_t i = 0; i < b.scene.regions.size(); ++i)
+      if (b.scene.regions[i].cls == RegionClass::kFloor) b.scene.floor_region = static_cast<int>(i);
+  return b;
+}
+
+int count_class(const SceneResult& scene, RegionClass c, float below = 0.f) {
+  int n = 0;
+  for (const auto& r : scene.regions) n += r.cls == c && r.height < below ? 1 : 0;
+  return n;
+}
+
+TEST(StairsUnit, TrackedFloorIsNotDoubtedAtTheTopOfADescent) {
+  // 0.45 m from the edge: the floor in front of it is under the view, the first tread is in view
+  // and nearer the user than the floor beside the stairwell.
+  SceneBuilder b = top_of_descent(0.45f, 41);
+  ASSERT_EQ(count_class(b.scene, RegionClass::kFloor, 1.f), 2) << "only the floor beside is in view";
+  StairStage stage(cfg());
+  StairResult r;
+  // Not tracked: the nearer lower level makes the floor doubtful (it may be a tread or a board).
+  b.scene.floor_tracked = false;
+  stage.run(b.scene, r);
+  EXPECT_FALSE(r.detected);
+  EXPECT_EQ(r.verdict, StairVerdict::kFloorDoubtful);
+  // Tracked (perception kept it from the frames before, the camera still at its height): the
+  // staircase is reported, its first edge where it is.
+  b.scene.floor_tracked = true;
+  stage.run(b.scene, r);
+  ASSERT_TRUE(r.detected) << to_string(r.verdict);
+  EXPECT_EQ(r.kind, StairKind::kDescending);
+  EXPECT_EQ(r.level_data[1].index, -1);
+  const Errors e = errors(r, b.truth);
+  EXPECT_LT(e.riser, 0.005f);
+  EXPECT_LT(e.tread, 0.01f);
+  EXPECT_LT(e.origin, 0.03f);
+  EXPECT_LT(e.yaw, 1.0f);
+}
+
+TEST(StairsUnit, HiddenFirstStepsAtTheEdgeOfADescent) {
+  // 0.2 m from the edge: the first tread lies wholly under the view, the second is cut by its
+  // bottom. The stack seen starts two risers down.
+  SceneBuilder b = top_of_descent(0.2f, 42);
+  float top = -1e9f;
+  for (const auto& r : b.scene.regions)
+    if (r.cls == RegionClass::kStepCandidate) top = std::max(top, r.height);
+  ASSERT_NEAR(top, -0.34f, 0.01f) << "the first tread must be out of view";
+  StairStage stage(cfg());
+  StairResult r;
+  b.scene.floor_tracked = true;
+  stage.run(b.scene, r);
+  ASSERT_TRUE(r.detected) << to_string(r.verdict);
+  EXPECT_EQ(r.kind, StairKind::kDescending);
+  EXPECT_EQ(stage.detection().descending.hidden_steps, 1);
+  EXPECT_EQ(r.level_data[1].index, -2);
+  EXPECT_NEAR(r.level_data[1].height, -0.34f, 0.01f);
+  const Errors e = errors(r, b.truth);
+  EXPECT_LT(e.riser, 0.005f);
+  EXPECT_LT(e.tread, 0.01f);
+  // The first edge (the floor's, out of view) is extrapolated from the steps seen.
+  EXPECT_LT(e.origin, 0.03f);
+  EXPECT_LT(e.yaw, 1.0f);
+
+  // Without tracking the floor's height is not trusted that far: nothing.
+  b.scene.floor_tracked = false;
+  stage.run(b.scene, r);
+  EXPECT_FALSE(r.detected);
+
+  // Still deeper under the view (two treads hidden): found as well.
+  SceneBuilder c = top_of_descent(-0.05f, 43);
+  c.scene.floor_tracked = true;
+  stage.run(c.scene, r);
+  ASSERT_TRUE(r.detected) << to_string(r.verdict);
+  EXPECT_EQ(r.level_data[1].index, -3);
+  EXPECT_LT(errors(r, c.truth).origin, 0.03f);
+}
+
+TEST(StairsUnit, HiddenFirstStepsNeedAWholeNumberOfRisersAndTheViewBottom) {
+  StairStage stage(cfg());
+  StairResult r;
+  {
+    // The stack lowered by half a riser: its first level is 2.5 risers down, no step of it.
+    SceneBuilder b = top_of_descent(0.2f, 44);
+    b.scene.floor_tracked = true;
+    for (auto& reg : b.scene.regions)
+      if (reg.cls == RegionClass::kStepCandidate) lower_region(b.scene, reg, 0.085f);
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.verdict, StairVerdict::kNoFirstStep);
+  }
+  {
+    // The first tread missing from the middle of the view (not hidden under its bottom): the
+    // level seen first does not reach the bottom of the view, so it is not taken as the second.
+    SceneBuilder b = top_of_descent(0.9f, 45);
+    b.scene.floor_tracked = true;
+    int first = -1;
+    for (std::size_t i = 0; i < b.scene.regions.size(); ++i)
+      if (b.scene.regions[i].cls == RegionClass::kStepCandidate && std::fabs(b.scene.regions[i].height + 0.17f) < 0.02f)
+        first = static_cast<int>(i);
+    ASSERT_GE(first, 0);
+    b.scene.regions[static_cast<std::size_t>(first)].cls = RegionClass::kObstacle;
+    b.scene.regions[static_cast<std::size_t>(first)].normal = Eigen::Vector3f::UnitZ();  // not horizontal
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.verdict, StairVerdict::kNoFirstStep);
+  }
 }
 
 TEST(StairsUnit, ManhattanAxesUsedOnlyWhenTheyAgree) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -79,6 +80,8 @@ struct Suite {
   std::vector<double> stage_ms;
   std::vector<Miss> misses;  ///< FN and FP frames and TPs of the wrong kind, runs merged
   int bin_tp[kBins] = {}, bin_fn[kBins] = {};
+  std::map<std::string, std::array<int, 2 * kBins>> kind_bins;  ///< per truth kind: TP then FN per bin
+  int descending_stage_misses = 0;  ///< FN on a descending flight with a floor and candidates (stairs stage)
 };
 
 /// Distance from the user (camera) to the first edge of the expected stair with most treads in
@@ -131,12 +134,17 @@ Suite run_suite() {
         int b = 0;
         while (b < kBins - 1 && !(dist < kDistanceBins[b])) ++b;
         (e.outcome == EvalOutcome::kTP ? out.bin_tp : out.bin_fn)[b]++;
+        auto& kb = out.kind_bins[to_string(e.truth_kind)];
+        kb[static_cast<std::size_t>(b + (e.outcome == EvalOutcome::kTP ? 0 : kBins))]++;
       }
       const bool bad = e.outcome == EvalOutcome::kFN || e.outcome == EvalOutcome::kFP || e.false_positive ||
                        (e.outcome == EvalOutcome::kTP && !e.kind_ok());
       if (!bad) continue;
       const Cause c = cause_of(e, result, scene, truth);
       ++out.cause_frames[c];
+      if (e.outcome == EvalOutcome::kFN && e.truth_kind == StairKind::kDescending &&
+          (c == Cause::kFloorDoubtful || c == Cause::kStage))
+        ++out.descending_stage_misses;
       Miss* last = out.misses.empty() ? nullptr : &out.misses.back();
       if (sequence && last && last->scene == p.name && last->cause == c && last->last + kSequenceStride == i &&
           last->eval.outcome == e.outcome) {
@@ -176,6 +184,13 @@ TEST(StairsSynthetic, Suite) {
     std::printf(" <%.0f m: %d/%d;", kDistanceBins[b] > 100 ? 99.0 : kDistanceBins[b], s.bin_tp[b],
                 s.bin_tp[b] + s.bin_fn[b]);
   std::printf("\n");
+  for (const auto& [kind, kb] : s.kind_bins) {
+    std::printf("  %-11s", kind.c_str());
+    for (int b = 0; b < kBins; ++b)
+      std::printf(" <%.0f m: %d/%d;", kDistanceBins[b] > 100 ? 99.0 : kDistanceBins[b], kb[static_cast<std::size_t>(b)],
+                  kb[static_cast<std::size_t>(b)] + kb[static_cast<std::size_t>(b + kBins)]);
+    std::printf("\n");
+  }
   const EvalSummary& a = s.table.all;
 
   {
@@ -214,16 +229,27 @@ TEST(StairsSynthetic, Suite) {
     const double stage_recall = static_cast<double>(a.tp) / std::max(1, a.tp + a.fn - perception_fn);
     std::printf("recall where perception gave a floor and step candidates: %.4f\n", stage_recall);
     // Measured on the whole walks (stride 3, seed 5, floorless route off, tree of this writing):
-    // recall 0.545, fully visible 0.952, 0.695 where perception gave a floor and candidates; from
-    // 1 m out 130 of 133 frames, within 1 m of the first edge 41 of 181. Issue 4's 99 % is NOT
-    // reached. The misses are the arrival: on an ascending flight the floor leaves the view within
-    // ~0.5 m of the first edge (perception: no floor); on a descending one the floor is doubted
-    // (a lower level nearer the user) or the first tread is no longer connected to the strip of
-    // floor left in view (stairs stage). The bounds are the measured figures less a margin, so a
-    // regression fails; raise them as those misses are fixed.
-    EXPECT_GE(a.recall(), 0.50);
-    EXPECT_GE(a.recall_fully_visible(), 0.90);
-    EXPECT_GE(stage_recall, 0.65);
+    // recall 0.774, fully visible 0.952, 0.988 where perception gave a floor and candidates; from
+    // 1 m out 130 of 133 frames, within 1 m of the first edge 113 of 181 (descending 87 of 89). Descending: 118 of 120
+    // (the 2 left are the step over the edge, where perception has no floor), every one fully
+    // visible, none missed by the stairs stage (before: 46 of 120, the arrival refused as "floor
+    // doubtful" or "no first step": the treads nearer than the floor beside the stairwell, the
+    // first tread or two under the bottom of the view). Issue 4's 99 % fully visible is NOT
+    // reached overall: the ascending arrivals lose the floor within ~0.5 m of the first edge
+    // (perception: no floor; the floorless route's business). The bounds are the measured figures
+    // less a margin, so a regression fails; raise them as those misses are fixed.
+    EXPECT_GE(a.recall(), 0.75);
+    EXPECT_GE(a.recall_fully_visible(), 0.93);
+    EXPECT_GE(stage_recall, 0.97);
+    {
+      const EvalSummary& d = s.table.by_kind.at("descending");
+      EXPECT_GE(d.recall(), 0.96);
+      EXPECT_EQ(d.full_fn, 0) << "a fully visible descending flight missed";
+      EXPECT_EQ(s.descending_stage_misses, 0) << "a descending flight refused by the stairs stage";
+      const auto& kb = s.kind_bins.at("descending");
+      EXPECT_GE(kb[0], 82) << "descending frames detected within 1 m of the edge (measured 87 of 89)";
+    }
+    EXPECT_GE(s.bin_tp[0], 105) << "frames detected within 1 m of the first edge (measured 113 of 181)";
     const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3], far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
     std::printf("recall from 1 m out: %.4f (%d frames)\n", static_cast<double>(far_tp) / std::max(1, far_tp + far_fn),
                 far_tp + far_fn);

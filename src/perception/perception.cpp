@@ -46,6 +46,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.T_floor_camera = Pose::Identity();
   out.camera_height = out.camera_tilt = out.camera_roll = 0.f;
   out.floor_region = -1;
+  out.floor_tracked = false;
   out.remembered_camera_height = 0.f;
   out.frames_since_floor = -1;
   out.manhattan_found = false;
@@ -75,6 +76,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
     out.camera_tilt = floor_est_.tilt;
     out.camera_roll = floor_est_.roll;
     out.floor_region = floor_est_.region;
+    out.floor_tracked = floor_est_.tracked;
     const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera);
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;

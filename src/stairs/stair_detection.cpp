@@ -8,6 +8,14 @@ namespace stairguide {
 namespace {
 constexpr int kDoubtfulMinPoints = 100;   // a lower level this big nearer than the floor ...
 constexpr float kDoubtfulMargin = 0.15f;  // ... by this much (m) makes the floor doubtful
+// Hidden first steps: at most this many steps under the bottom of the view. From a chest camera
+// looking 30-60 degrees down, standing at the edge, two are hidden at most; more would be a level
+// far below that no one would call the next flight.
+constexpr int kMaxHiddenSteps = 3;
+// The first level seen reaches the bottom of the view when its lowest image row (as y/z) is within
+// this of the lowest row any region reaches (about 10 px at a 525 px focal length; regions lose a
+// few rows at the border to the normal estimation).
+constexpr float kViewBottomSlack = 0.02f;
 }  // namespace
 
 StairDetection::StairDetection(const ClassificationConfig& classification, const StairDetectionConfig& config)
@@ -32,7 +40,23 @@ void StairDetection::prepare(const SceneResult& scene, int region, Candidate& c)
   }
 }
 
-bool StairDetection::connected(const Candidate& c, const LevelSeed& level) const {
+namespace {
+// The lowest image row (as y/z: no intrinsics needed) that a region's points reach.
+float lowest_row(const PlaneRegion& r) {
+  float low = -std::numeric_limits<float>::max();
+  for (const Eigen::Vector3f& p : r.points)
+    if (p.z() > 0.05f) low = std::max(low, p.y() / p.z());
+  return low;
+}
+}  // namespace
+
+float StairDetection::view_bottom(const SceneResult& scene) const {
+  float low = -std::numeric_limits<float>::max();
+  for (const PlaneRegion& r : scene.regions) low = std::max(low, lowest_row(r));
+  return low;
+}
+
+bool StairDetection::connected(const Candidate& c, const LevelSeed& level, bool horizontal) const {
   const float r = cfg_.connection_radius, r2 = r * r;
   const int need = std::max(1, (cfg_.connection_min_points + c.stride - 1) / c.stride);
   int found = 0;
@@ -41,14 +65,20 @@ bool StairDetection::connected(const Candidate& c, const LevelSeed& level) const
     if (slot < 0) continue;
     const Candidate& l = pool_[static_cast<std::size_t>(slot)];
     if (l.sample.empty()) continue;
-    // Boxes farther apart than the radius cannot hold a pair of neighbours.
-    const Eigen::Vector3f gap = (l.lo - c.hi).cwiseMax(c.lo - l.hi).cwiseMax(Eigen::Vector3f::Zero());
-    if (gap.squaredNorm() > r2) continue;
-    const Eigen::Vector3f blo = l.lo.array() - r, bhi = l.hi.array() + r;
+    // Boxes farther apart than the radius cannot hold a pair of neighbours (in 3D; the horizontal
+    // test is rare and runs on the whole samples).
+    if (!horizontal) {
+      const Eigen::Vector3f gap = (l.lo - c.hi).cwiseMax(c.lo - l.hi).cwiseMax(Eigen::Vector3f::Zero());
+      if (gap.squaredNorm() > r2) continue;
+    }
+    const float reach = horizontal ? std::numeric_limits<float>::max() : r;
+    const Eigen::Vector3f blo = l.lo.array() - reach, bhi = l.hi.array() + reach;
     for (const Eigen::Vector3f& p : c.sample) {
       if ((p.array() < blo.array()).any() || (p.array() > bhi.array()).any()) continue;
       for (const Eigen::Vector3f& q : l.sample) {
-        if ((p - q).squaredNorm() <= r2) {
+        Eigen::Vector3f d = p - q;
+        if (horizontal) d -= up_ * up_.dot(d);
+        if (d.squaredNorm() <= r2) {
           if (++found >= need) return true;
           break;
         }
@@ -60,6 +90,7 @@ bool StairDetection::connected(const Candidate& c, const LevelSeed& level) const
 
 void StairDetection::build(int direction, StairHypothesis& hyp) {
   hyp.direction = direction;
+  hyp.hidden_steps = 0;
   hyp.levels.resize(1);
   LevelSeed& floor = hyp.levels[0];
   floor.index = 0;
@@ -71,7 +102,6 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
     floor.point_count += static_cast<int>(pool_[static_cast<std::size_t>(slot)].sample.size()) *
                          pool_[static_cast<std::size_t>(slot)].stride;
   }
-  const bool floor_visible = !floor.regions.empty();
 
   // Candidates on this side of the floor, sorted by distance to it (Algorithm 1: sortByHeight).
   order_.clear();
@@ -82,7 +112,21 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
   });
   hyp.candidates = static_cast<int>(order_.size());
   assigned_.assign(order_.size(), 0);
+  sweep(hyp);
+  if (hyp.step_levels() == 0 && direction < 0 && floor_tracked_ && !floor.regions.empty()) build_hidden(hyp);
 
+  hyp.rejected = 0;
+  for (char a : assigned_)
+    if (!a) ++hyp.rejected;
+  if (hyp.candidates == 0)
+    hyp.verdict = StairVerdict::kNoCandidates;
+  else
+    hyp.verdict = hyp.step_levels() > 0 ? StairVerdict::kDetected : StairVerdict::kNoFirstStep;
+}
+
+void StairDetection::sweep(StairHypothesis& hyp) {
+  const LevelSeed& floor = hyp.levels[0];
+  const bool floor_visible = !floor.regions.empty();
   const float hmin = cls_.step_height_min - cfg_.height_tolerance;
   const float hmax = cls_.step_height_max + cfg_.height_tolerance;
   // The first level may be a curb lower than H_min; modelling decides whether a low level is one.
@@ -140,7 +184,7 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
         l.regions.push_back(c.region);
       } else {
         LevelSeed& l = hyp.levels.emplace_back();
-        l.index = n_levels + 1;
+        l.index = hyp.levels[static_cast<std::size_t>(n_levels)].index + 1;
         l.height = c.height;
         l.point_count = pts;
         l.regions.assign(1, c.region);
@@ -149,13 +193,60 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
       changed = true;
     }
   }
-  hyp.rejected = 0;
-  for (char a : assigned_)
-    if (!a) ++hyp.rejected;
-  if (hyp.candidates == 0)
-    hyp.verdict = StairVerdict::kNoCandidates;
-  else
-    hyp.verdict = hyp.step_levels() > 0 ? StairVerdict::kDetected : StairVerdict::kNoFirstStep;
+}
+
+bool StairDetection::build_hidden(StairHypothesis& hyp) {
+  const float hmin = cls_.step_height_min - cfg_.height_tolerance;
+  const float hmax = cls_.step_height_max + cfg_.height_tolerance;
+  const LevelSeed& floor = hyp.levels[0];
+  if (!scene_) return false;
+  view_bottom_ = view_bottom(*scene_);
+  // The seed: the candidate nearest the floor in height that is too low to be the first step,
+  // reaches the bottom of the view and lies beside the floor seen from above. Candidates are in
+  // height order, so the first that qualifies is the first level seen.
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    if (assigned_[i]) continue;
+    const Candidate& c = pool_[static_cast<std::size_t>(order_[i])];
+    const float s = std::fabs(c.height);
+    if (s <= hmax) continue;
+    if (s > static_cast<float>(kMaxHiddenSteps + 1) * hmax) break;
+    if (static_cast<int>(c.sample.size()) * c.stride < kDoubtfulMinPoints) continue;
+    if (lowest_row(scene_->regions[static_cast<std::size_t>(c.region)]) < view_bottom_ - kViewBottomSlack) continue;
+    if (!connected(c, floor, true)) continue;
+    LevelSeed& l = hyp.levels.emplace_back();
+    l.index = 1;  // provisional: set from the stack's spacing below
+    l.height = c.height;
+    l.point_count = static_cast<int>(c.sample.size()) * c.stride;
+    l.regions.assign(1, c.region);
+    assigned_[i] = 1;
+    sweep(hyp);
+    // The stack's own spacing is the riser; the first level seen must lie a whole number of them
+    // (two or more) below the floor. One level alone says nothing of the riser.
+    const int n = hyp.step_levels();
+    bool ok = n >= 2;
+    int m = 0;
+    if (ok) {
+      const float first = std::fabs(hyp.levels[1].height), last = std::fabs(hyp.levels.back().height);
+      const float riser = (last - first) / static_cast<float>(n - 1);
+      ok = riser >= hmin && riser <= hmax;
+      if (ok) {
+        m = static_cast<int>(std::lround(first / riser));
+        ok = m >= 2 && m <= kMaxHiddenSteps + 1 &&
+             std::fabs(first - static_cast<float>(m) * riser) <= cfg_.same_level_tolerance;
+      }
+    }
+    if (ok) {
+      for (int k = 1; k <= n; ++k) hyp.levels[static_cast<std::size_t>(k)].index = m + k - 1;
+      hyp.hidden_steps = m - 1;
+      return true;
+    }
+    // Not a staircase with hidden first steps: undo, nothing else is tried (the next candidate
+    // down would be a level of this same stack).
+    hyp.levels.resize(1);
+    assigned_.assign(order_.size(), 0);
+    return false;
+  }
+  return false;
 }
 
 void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
@@ -164,6 +255,7 @@ void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
   out.descending.levels.clear();
   out.ascending.candidates = out.descending.candidates = 0;
   out.ascending.rejected = out.descending.rejected = 0;
+  out.ascending.hidden_steps = out.descending.hidden_steps = 0;
   out.ascending.verdict = out.descending.verdict = StairVerdict::kNoCandidates;
   out.ascending.direction = 1;
   out.descending.direction = -1;
@@ -176,6 +268,9 @@ void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
   const Eigen::Matrix3f R = scene.T_floor_camera.linear();
   const Eigen::Vector3f up = R.row(1).transpose();
   const float up_offset = scene.T_floor_camera.translation().y();
+  up_ = up;
+  floor_tracked_ = scene.floor_tracked;
+  view_bottom_ = -std::numeric_limits<float>::max();
   const float cos_parallel = std::cos(cls_.parallel_threshold);
 
   region_slot_.assign(scene.regions.size(), -1);
@@ -216,8 +311,12 @@ void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
   }
   // The floor the user stands on is the nearest level in front of the feet. A lower level nearer
   // than it means perception took something else (a tread, a shelf board) for the floor; every
-  // height would then be off by that much, so nothing is reported.
-  if (!floor_slots_.empty()) {
+  // height would then be off by that much, so nothing is reported. Not so for a tracked floor: at
+  // the top of a descent the floor at the feet leaves the view, the floor seen beside the
+  // stairwell is farther than the treads below, and perception has kept that floor only because
+  // it agrees with the one verified on the frames before and the camera is still at the height it
+  // had over it (the user has not stepped down).
+  if (!floor_slots_.empty() && !scene.floor_tracked) {
     auto near_distance = [&](const Candidate& c) {
       dist_.clear();
       for (const auto& p : c.sample) dist_.push_back((p - up * up.dot(p)).norm());
@@ -241,8 +340,10 @@ void StairDetection::run(const SceneResult& scene, StairDetectionOutput& out) {
       }
     }
   }
+  scene_ = &scene;
   build(1, out.ascending);
   build(-1, out.descending);
+  scene_ = nullptr;
   out.verdict = StairVerdict::kDetected;
 }
 

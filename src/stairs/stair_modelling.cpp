@@ -607,8 +607,10 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   fit_e_.clear();
   fit_k_.push_back(0.f);
   fit_e_.push_back(0.f);
+  // Against the step index, not the position in the list: the first steps may be out of view
+  // (LevelSeed::index).
   for (int k = 1; k <= n; ++k) {
-    fit_k_.push_back(static_cast<float>(k));
+    fit_k_.push_back(static_cast<float>(hyp.levels[static_cast<std::size_t>(k)].index));
     fit_e_.push_back(levels_[static_cast<std::size_t>(k)].plane - levels_[0].plane);
   }
   const LineFit hfit = fit_line(fit_k_, fit_e_);
@@ -696,14 +698,17 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   if (n >= 2) {
     fit_k_.clear();
     fit_e_.clear();
+    fit_level_.clear();
     if (floor_edge) {
       fit_k_.push_back(0.f);
       fit_e_.push_back(fl.edge);
+      fit_level_.push_back(0);
     }
     for (int k = 1; k <= n; ++k) {
       if (dir < 0 && landing_[static_cast<std::size_t>(k)]) continue;
-      fit_k_.push_back(static_cast<float>(k));
+      fit_k_.push_back(static_cast<float>(hyp.levels[static_cast<std::size_t>(k)].index));
       fit_e_.push_back(out.level_data[static_cast<std::size_t>(k)].edge);
+      fit_level_.push_back(k);
     }
     // Consensus over the lines through two edges: the line most edges lie near (within
     // edge_max_residual), refitted to those. Edges off it are a landing or the lower floor seen as
@@ -742,7 +747,7 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
         tmp_.push_back(fit_k_[k]);
         sorted_.push_back(fit_e_[k]);
       } else {
-        outlier_[static_cast<std::size_t>(fit_k_[k])] = 1;
+        outlier_[static_cast<std::size_t>(fit_level_[k])] = 1;
       }
     }
     efit = fit_line(tmp_, sorted_);
@@ -771,7 +776,8 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   // ---- pose: origin at the centre of the first edge ----
   float edge_b = 0.f, plane = 0.f;
   if (dir > 0) {
-    edge_b = efit.ok ? efit.intercept + efit.slope : out.level_data[1].edge;
+    const float first = static_cast<float>(hyp.levels[1].index);
+    edge_b = efit.ok ? efit.intercept + efit.slope * first : out.level_data[1].edge;
     plane = levels_[1].plane;
   } else {
     if (efit.ok)
@@ -796,7 +802,7 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   for (int k = 0; k <= n; ++k) {
     StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
     const LevelSeed& s = hyp.levels[static_cast<std::size_t>(k)];
-    o.index = dir * k;
+    o.index = dir * hyp.levels[static_cast<std::size_t>(k)].index;
     o.height = levels_[static_cast<std::size_t>(k)].plane - levels_[0].plane;
     o.regions = s.regions;
     if (k == 0) continue;  // the floor's points stay with perception

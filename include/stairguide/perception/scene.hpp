@@ -70,6 +70,11 @@ struct SceneResult {
   float camera_tilt = 0.f;                ///< rad, optical axis below horizontal
   float camera_roll = 0.f;                ///< rad
   int floor_region = -1;                  ///< index into regions, -1 when the floor is not a region
+  /// The floor was chosen by agreement with the previous frames' floor (FloorEstimate::tracked):
+  /// either it passed every check again, or it was kept at the top of a descent while the camera
+  /// stays at the height last verified on a clear view. Its height is then the one the user's feet
+  /// stand on even where the treads below are nearer the user than the floor seen beside them.
+  bool floor_tracked = false;
   /// m, the camera's height above the user's feet as last measured on a floor that passed every
   /// check, while it is remembered (FloorConfig::track_forget_frames), also on frames where no
   /// floor is found; 0 when unknown. A property of the wearer, not of the place: with the floor

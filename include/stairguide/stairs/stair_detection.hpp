@@ -10,8 +10,22 @@
 /// one riser from the floor and connected to it when the floor is visible as a region. Candidates
 /// that never connect (a table, a shelf board) are left out as obstacles. When a level below the
 /// floor lies nearer the user than the floor itself, the floor cannot be the one the user stands on
-/// and the frame is refused (kFloorDoubtful). Whether the levels form a
-/// valid staircase, single step or curb is decided by modelling (stair_modelling.hpp).
+/// and the frame is refused (kFloorDoubtful), unless perception tracked that floor from the frames
+/// before (SceneResult::floor_tracked: at the top of a descent the treads below are nearer the
+/// user than the floor beside the stairwell).
+///
+/// Hidden first steps (descending, tracked floor only): at the top of a descent the first tread or
+/// two lie under the bottom of the view. The first level seen is then two or more risers down and
+/// cannot be the first step; it is taken as step m (LevelSeed::index) when the levels seen form an
+/// evenly spaced stack whose spacing is a riser (H_min..H_max), the first of them lies m risers
+/// below the floor (2 <= m <= 4), it reaches the bottom of the view (the steps above it are out of
+/// view, not missing) and it lies, seen from above, within the connection radius of the floor (the
+/// stairwell is cut into the floor the user stands on). A table top is never below the floor, which
+/// is what the paper's connection rule guards against; here the tracked floor's height and the
+/// stack's own spacing say which step the first seen level is.
+///
+/// Whether the levels form a valid staircase, single step or curb is decided by modelling
+/// (stair_modelling.hpp).
 
 #include <Eigen/Core>
 #include <vector>
@@ -24,7 +38,9 @@ namespace stairguide {
 
 /// A level found by detection: the regions fused into it and its height.
 struct LevelSeed {
-  int index = 0;             ///< 0 = the floor, k = k-th step from the floor
+  /// 0 = the floor, k = k-th step from the floor. Consecutive seeds are consecutive steps; the
+  /// first step seed may have an index above 1 when the steps before it are out of view.
+  int index = 0;
   float height = 0.f;        ///< m from the floor along its normal (negative below), point-weighted
   int point_count = 0;       ///< points of the fused regions
   std::vector<int> regions;  ///< indices into SceneResult::regions
@@ -36,6 +52,7 @@ struct StairHypothesis {
   StairVerdict verdict = StairVerdict::kNoCandidates;  ///< kDetected when at least one level was found
   int candidates = 0;                ///< step candidates on this side of the floor
   int rejected = 0;                  ///< of those, left out (not connected, wrong height)
+  int hidden_steps = 0;              ///< steps between the floor and the first level seen, out of view
   std::vector<LevelSeed> levels;     ///< [0] is the floor (its regions may be empty), then steps 1..n
   int step_levels() const { return levels.empty() ? 0 : static_cast<int>(levels.size()) - 1; }
 };
@@ -66,8 +83,15 @@ class StairDetection {
 
   void prepare(const SceneResult& scene, int region, Candidate& c) const;
   /// Points of `c` within the radius of the regions of `level`, >= the minimum (scaled by stride).
-  bool connected(const Candidate& c, const LevelSeed& level) const;
+  /// With `horizontal`, distances are taken in the horizontal plane (heights left out).
+  bool connected(const Candidate& c, const LevelSeed& level, bool horizontal = false) const;
   void build(int direction, StairHypothesis& hyp);
+  /// Algorithm 1's loop: adds unassigned candidates to the levels of `hyp` until nothing changes.
+  void sweep(StairHypothesis& hyp);
+  /// The hidden-first-steps route (see the file comment); true when it found a staircase.
+  bool build_hidden(StairHypothesis& hyp);
+  /// Lowest image row (as y/z) that any region of the scene reaches: the bottom of the view.
+  float view_bottom(const SceneResult& scene) const;
 
   ClassificationConfig cls_;
   StairDetectionConfig cfg_;
@@ -79,6 +103,10 @@ class StairDetection {
   std::vector<char> assigned_;
   std::vector<float> dist_;
   int used_ = 0;
+  bool floor_tracked_ = false;
+  Eigen::Vector3f up_ = -Eigen::Vector3f::UnitY();  ///< floor's up, camera frame
+  float view_bottom_ = 0.f;                         ///< of the current scene, see view_bottom()
+  const SceneResult* scene_ = nullptr;              ///< the scene being run (only during run())
 };
 
 }  // namespace stairguide

@@ -17,8 +17,10 @@
 ///   unbiased for evenly spread points and insensitive to a few strays. Ascending, the risers
 ///   facing the user place the edges in grazing views, and replace an edge whose tread's near rows
 ///   are hidden (one lying more than a nosing beyond its riser).
-/// - Tread: slope of the edge positions against the level index (edge to edge); riser: slope of the
+/// - Tread: slope of the edge positions against the step index (edge to edge); riser: slope of the
 ///   level heights (centroid to centroid, the floor included); width: lateral extent of all steps.
+///   The step index is LevelSeed::index, so steps hidden under the view (detection's hidden first
+///   steps) count, and the first edge is extrapolated to index 0 (descending: the floor's edge).
 /// - Origin: centre of the first edge (ascending: nosing of tread 1; descending: floor's edge).
 /// - Validation: riser, tread, 2R+T and width against the building code (a width cut by the image
 ///   border only against half the minimum), evenly spaced edges; a
@@ -85,6 +87,7 @@ class StairModelling {
   std::vector<float> a_, b_;          ///< scratch coordinates
   std::vector<Eigen::Vector2f> sub_;  ///< scratch subsample for hulls
   std::vector<float> fit_k_, fit_e_;  ///< scratch for the edge fit
+  std::vector<int> fit_level_;        ///< level (position in the hypothesis) of each fit entry
   std::vector<float> ba_, bb_, a_band_, bin_a_, bin_e_, bin_ext_, bin_at_, sorted_, tmp_;  ///< scratch for boundaries
   std::vector<int> bin_count_;
   std::vector<char> landing_;         ///< per level: deeper than a tread (landing or floor)
