@@ -2,9 +2,13 @@
 // hand-built perception results (test_stairs_scene.hpp) with the floor taken out of view.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "test_stairs_scene.hpp"
 
@@ -14,7 +18,7 @@ using namespace stairguide;
 using sgtest::SceneBuilder;
 using sgtest::StairSpec;
 
-/// The pipeline's defaults with the floorless route on (it is off by default, see floorless.hpp).
+/// The pipeline's defaults with the floorless route on (the default; set here so the tests say it).
 PipelineConfig on() {
   PipelineConfig c;
   c.stair_detection.floorless = true;
@@ -202,6 +206,152 @@ TEST(StairsFloorless, ImplausibleVerticalIsRefused) {
   stage.run(b.scene, r);
   EXPECT_FALSE(r.detected);
   EXPECT_FALSE(stage.floorless_trace().up_found);
+}
+
+/// Distance between the estimated and the true first-edge centres, m.
+float origin_error(const StairResult& r, const StairTruth& t) {
+  return (r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm();
+}
+
+// The floor out of view but the camera's height above the feet remembered (perception's memory):
+// the steps are placed from the feet, the first edge and the step indices as with a floor.
+TEST(StairsFloorless, RememberedFloorPlacesTheFirstStep) {
+  const PipelineConfig cfg = on();
+  StairStage stage(cfg);
+  constexpr float kHeight = 1.4f;
+  int views = 0, placed = 0, hidden_placed = 0, floor_placed = 0;
+  float worst = 0.f;
+  unsigned seed = 200;
+  for (int dir : {1, -1}) {
+    for (float tilt : {35.f, 50.f}) {
+      for (float yaw : {-10.f, 15.f}) {
+        StairSpec s;
+        s.direction = dir;
+        s.steps = 5;
+        s.yaw_deg = yaw;
+        s.distance = dir > 0 ? 1.0f : 0.5f;
+        s.riser = dir > 0 ? 0.17f : 0.16f;
+        s.tread = dir > 0 ? 0.29f : 0.31f;
+        // (a) the floor out of view: the first seen level is the first step.
+        SceneBuilder b(kHeight, tilt, seed++);
+        b.add_stairs(s);
+        drop_floor(b.scene);
+        b.scene.remembered_camera_height = kHeight;
+        StairResult r;
+        stage.run(b.scene, r);
+        ++views;
+        if (r.detected) {
+          EXPECT_TRUE(r.floor_remembered);
+          EXPECT_FALSE(r.without_floor);
+          EXPECT_EQ(r.direction(), dir);
+          EXPECT_EQ(r.level_data[1].index, dir);
+          EXPECT_NEAR(r.level_data[1].height, dir * s.riser, 0.01f);
+          worst = std::max(worst, origin_error(r, b.truth));
+          placed += origin_error(r, b.truth) < 0.03f;
+        } else {
+          ADD_FAILURE() << "dir " << dir << " tilt " << tilt << " yaw " << yaw << ": " << to_string(r.verdict);
+        }
+        // (b) the floor seen as a level (the floor detector refused it): it is level 0.
+        SceneBuilder c(kHeight, tilt, seed++);
+        c.add_stairs(s);
+        c.scene.floor_found = false;
+        c.scene.remembered_camera_height = kHeight;
+        stage.run(c.scene, r);
+        if (r.detected && r.floor_remembered && origin_error(r, c.truth) < 0.03f && r.level_data[1].index == dir) ++floor_placed;
+        if (dir < 0) continue;
+        // (c) tread 1 out of view too (under the camera): placed one tread before tread 2.
+        SceneBuilder d(kHeight, tilt, seed++);
+        d.add_stairs(s);
+        drop_floor(d.scene);
+        drop_first_treads(d.scene, 1);
+        d.scene.remembered_camera_height = kHeight;
+        stage.run(d.scene, r);
+        if (r.detected && r.floor_remembered && origin_error(r, d.truth) < 0.03f && r.level_data[1].index == 2 &&
+            std::fabs(r.level_data[1].height - 2.f * s.riser) < 0.01f)
+          ++hidden_placed;
+      }
+    }
+  }
+  std::printf("remembered floor: first edge within 3 cm in %d of %d views (worst %.2f cm); floor seen as a level %d of "
+              "%d; tread 1 hidden %d of %d\n",
+              placed, views, 100.f * worst, floor_placed, views, hidden_placed, views / 2);
+  EXPECT_EQ(placed, views);
+  EXPECT_EQ(floor_placed, views);
+  EXPECT_EQ(hidden_placed, views / 2);
+}
+
+TEST(StairsFloorless, StackOffTheRememberedFeetIsNoStaircase) {
+  // The same staircase with a remembered height that puts its first level half a riser from the
+  // feet, or with more steps out of view than may be hidden: no staircase (an index would be a
+  // guess).
+  const PipelineConfig cfg = on();
+  StairStage stage(cfg);
+  StairSpec s;
+  s.steps = 6;
+  s.distance = 1.2f;
+  {
+    SceneBuilder b(1.4f, 45.f, 41);
+    b.add_stairs(s);
+    drop_floor(b.scene);
+    b.scene.remembered_camera_height = 1.4f + 0.5f * s.riser;
+    StairResult r;
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.verdict, StairVerdict::kNoFirstStep);
+    EXPECT_TRUE(stage.floorless_trace().anchored);
+  }
+  {
+    SceneBuilder b(1.4f, 45.f, 42);
+    b.add_stairs(s);
+    drop_floor(b.scene);
+    drop_first_treads(b.scene, 2);  // treads 1 and 2 out of view: tread 3 is the first seen
+    b.scene.remembered_camera_height = 1.4f;
+    StairResult r;
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(stage.floorless_trace().first_index, -1);
+  }
+}
+
+// End to end on the synthetic world: the walk up to the first step of the default climb, every
+// frame through perception (it tracks and remembers the floor as in use). In the last half metre
+// the floor leaves the view; perception remembers the camera height and the floorless route places
+// the steps from the feet.
+TEST(StairsFloorless, ArrivalAtTheFootOfAClimb) {
+  const PipelineConfig cfg = on();
+  Perception perception(cfg);
+  StairStage stage(cfg);
+  SceneResult scene;
+  StairResult r;
+  RgbdFrame frame;
+  FrameTruth truth;
+  int floorless = 0, expected = 0, tp = 0, off_edge = 0, wrong_direction = 0, remembered = 0;
+  for (long i = 0; i <= 212; ++i) {
+    synth::render_preset_frame("ascending_approach_climb", i, 5u, synth::SynthOptions{}, frame, truth);
+    perception.process(frame, scene);
+    stage.run(scene, frame.intrinsics, r);
+    if (scene.floor_found) continue;
+    const StairFrameEval e = evaluate_stair_frame(r, truth);
+    if (e.outcome == EvalOutcome::kSkipped) continue;  // on the first step: traversal's
+    ++floorless;
+    remembered += r.detected && r.floor_remembered;
+    expected += e.outcome == EvalOutcome::kTP || e.outcome == EvalOutcome::kFN;
+    tp += e.outcome == EvalOutcome::kTP;
+    off_edge += e.false_positive;
+    wrong_direction += e.wrong_direction;
+    if (e.outcome != EvalOutcome::kTP)
+      std::printf("frame %ld: %s, %s (levels %d, first index %d, first level %.3f m from the feet)\n", i,
+                  to_string(e.outcome), to_string(r.verdict), r.levels, stage.floorless_trace().first_index,
+                  stage.floorless_trace().first_offset);
+  }
+  std::printf("arrival without floor: %d frames, %d expected, %d found (%d from the remembered floor), %d off the "
+              "edge, %d wrong direction\n",
+              floorless, expected, tp, remembered, off_edge, wrong_direction);
+  ASSERT_GE(floorless, 60) << "the walk should lose the floor before the first step";
+  EXPECT_EQ(off_edge, 0) << "a staircase placed off its first edge";
+  EXPECT_EQ(wrong_direction, 0);
+  EXPECT_EQ(remembered, tp) << "every detection here comes from the remembered floor";
+  EXPECT_GE(tp, 0.85 * expected);
 }
 
 TEST(StairsFloorless, OffByConfig) {

@@ -14,6 +14,8 @@ constexpr std::size_t kFitPoints = 500; // points per region in the fit of the c
 constexpr float kLandingDepth = 0.6f;   // m, a level deeper than this is a landing or a floor
 constexpr float kMinRise = 0.05f;       // m, a higher level's near boundary this much farther (nearer)
                                         // than the lower one's says ascending (descending)
+constexpr float kFloorDepthSlack = 0.08f;  // m, a level cut by the image border and seen deeper than
+                                           // the tread by this is no tread (nosing, edge noise)
 
 float clampf(float x, float lo, float hi) { return std::min(hi, std::max(lo, x)); }
 
@@ -316,6 +318,7 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   out.edge_right.setZero();
   out.method = StairAxesMethod::kNone;
   out.without_floor = true;
+  out.floor_remembered = false;
   out.level_data.clear();
   out.candidates = out.rejected_candidates = 0;
   if (!find_up(scene)) return;
@@ -393,20 +396,118 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   }
   const double slope = (n * skh - sk * sh) / (n * skk - sk * sk);
   const float level0 = static_cast<float>((sh - slope * sk) / n);
+  if (scene.remembered_camera_height > 0.f) {
+    run_anchored(scene, K, dir, std::fabs(static_cast<float>(slope)), level0, out);
+    return;
+  }
   model(scene, K, dir, 0, level0, out);
-  // Ascending, a lowest level deeper than a landing is the floor the user stands on (seen, but
-  // refused by the floor detector, e.g. a level camera): it becomes level 0 at its own height and
-  // the treads above it are the steps, so the first edge is the first tread's.
-  if (dir > 0 && out.level_data.size() > 1 && out.level_data[1].depth_max - out.level_data[1].depth_min > kLandingDepth) {
+  // Cold start: is the first level seen the first step, or the floor the user stands on (seen, but
+  // refused by the floor detector: a level camera, a floor strip at the foot of the steps)? The
+  // floor runs to the user's feet, so its near boundary is the image border; a first step whose
+  // nosing is in view is no floor. Cut by the border, a tread shows at most its own depth: a level
+  // deeper than the tread measured on the others is the floor. Shallower, nothing in one frame
+  // tells a floor strip from a tread seen from above, and a staircase placed one step off is
+  // worse for the user than none: nothing is reported. (Deeper than a tread but shallower than a
+  // landing is left undecided too: on far, grazing views the levels' depths are loose.)
+  if (out.level_data.size() < 2) return;
+  {
+    const StairLevel& l1 = out.level_data[1];
+    const float y = dir > 0 ? 0.f : l1.height;  // the level's height in the stair frame
+    trace_.first_near_cut = K && line_cut(*K, out, 1, y, l1.depth_min);
+  }
+  if (!trace_.first_near_cut) return;
+  const float depth = out.level_data[1].depth_max - out.level_data[1].depth_min;
+  const bool deep = depth > std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
+  // Seen at a chest camera's pitch (the floor detector's range), the floor the user stands on lies
+  // a chest camera's height below it (the same detector's range): a level nearer the camera, or
+  // farther, is a step whatever its depth. A camera held level (a hand-held or tripod view) says
+  // nothing of its height: there the rule does not apply.
+  const float cam_above = -nodes_[static_cast<std::size_t>(chain_[0])].height;
+  const bool chest_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
+  const bool floor_height = cam_above >= floor_.height_min - det_.same_level_tolerance &&
+                            cam_above <= floor_.height_max + det_.same_level_tolerance;
+  if (chest_view && !floor_height) return;
+  if (!deep) {
+    out.detected = false;
+    out.verdict = StairVerdict::kNoFirstStep;
+    return;
+  }
+  trace_.floor_level = true;
+  if (n - 1 < std::max(2, det_.floorless_min_levels)) {
+    // A floor and one level on it: the single-level case needs the real floor (paper 4.1).
+    out.detected = false;
+    out.verdict = StairVerdict::kNoFloor;
+    out.levels = n - 1;
+    return;
+  }
+  model(scene, K, dir, 1, nodes_[static_cast<std::size_t>(chain_[0])].height, out);
+}
+
+void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser,
+                                   float level0, StairResult& out) {
+  // The feet lie the remembered camera height below the camera along up (the camera sits at up .
+  // p = 0). chain_ is in stair order: chain_[0] is the first level seen from the user.
+  trace_.anchored = true;
+  const int n = static_cast<int>(chain_.size());
+  const float h0 = nodes_[static_cast<std::size_t>(chain_[0])].height;
+  const float a0 = static_cast<float>(dir) * (h0 + scene.remembered_camera_height);
+  trace_.first_offset = a0;
+  const int kmax = 1 + std::max(0, det_.floorless_max_hidden_steps);
+  const int k = riser > 0.f ? static_cast<int>(std::lround(a0 / riser)) : -1;
+  out.levels = n;
+  if (k < 0 || k > kmax || std::fabs(a0 - static_cast<float>(k) * riser) > det_.floorless_anchor_tolerance) {
+    // Not a whole number of risers from the feet (or too many steps hidden): a stack of shelves,
+    // furniture, or a staircase the remembered height no longer fits. Nothing is reported.
+    out.detected = false;
+    out.verdict = StairVerdict::kNoFirstStep;
+    return;
+  }
+  trace_.first_index = k;
+  if (k == 0) {
+    // The floor itself is in the stack (seen, but refused by the floor detector): level 0.
     trace_.floor_level = true;
     if (n - 1 < std::max(2, det_.floorless_min_levels)) {
-      // A floor and one level on it: the single-level case needs the real floor (paper 4.1).
       out.detected = false;
       out.verdict = StairVerdict::kNoFloor;
       out.levels = n - 1;
       return;
     }
-    model(scene, K, dir, 1, nodes_[static_cast<std::size_t>(chain_[0])].height, out);
+    model(scene, K, dir, 1, h0, out);
+  } else {
+    // Level 0 of the fit lies one riser before the first seen level: the floor when k = 1 (the
+    // fit's, within the tolerance of the remembered one), the last hidden step otherwise.
+    model(scene, K, dir, 0, level0, out);
+    if (k >= 2 && out.detected) {
+      if (out.tread_m > 0.f) {
+        add_hidden_steps(out, dir, k - 1);
+      } else {
+        // Where the hidden steps' edges lie needs the tread.
+        out.detected = false;
+        out.verdict = StairVerdict::kNoFirstStep;
+      }
+    }
+  }
+  out.without_floor = false;
+  out.floor_remembered = true;
+}
+
+void FloorlessStairs::add_hidden_steps(StairResult& out, int dir, int hidden) {
+  // The model's level 0 was step `hidden` and its origin step hidden + 1's edge (ascending) or
+  // step hidden's far edge (descending): both move `hidden` treads towards the user and `hidden`
+  // risers towards the floor.
+  const Eigen::Vector3f ys = out.T_camera_stair.linear().col(1), zs = out.T_camera_stair.linear().col(2);
+  const float dz = static_cast<float>(hidden) * out.tread_m, dy = static_cast<float>(hidden) * out.riser_m;
+  const Eigen::Vector3f move = -static_cast<float>(dir) * dy * ys - dz * zs;
+  out.T_camera_stair.translation() += move;
+  out.edge_left += move;
+  out.edge_right += move;
+  for (std::size_t k = 1; k < out.level_data.size(); ++k) {
+    StairLevel& l = out.level_data[k];
+    l.edge += dz;
+    l.depth_min += dz;
+    l.depth_max += dz;
+    l.height += static_cast<float>(dir) * dy;
+    l.index += dir * hidden;
   }
 }
 
@@ -485,15 +586,19 @@ void FloorlessStairs::model(const SceneResult& scene, const CameraIntrinsics* K,
 }
 
 bool FloorlessStairs::edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const {
-  // Samples along the level's edge line: where most lie on (or beyond) the image border, the edge
-  // is where the view ends, not where the level does.
+  return line_cut(K, r, k, y, r.level_data[static_cast<std::size_t>(k)].edge);
+}
+
+bool FloorlessStairs::line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y, float z) const {
+  // Samples along the line across the level: where most lie on (or beyond) the image border, the
+  // level's boundary there is where the view ends, not where the level does.
   const StairLevel& l = r.level_data[static_cast<std::size_t>(k)];
   const float margin = 0.03f * static_cast<float>(std::max(K.width, K.height));
   int cut = 0;
   constexpr int kSamples = 9;
   for (int i = 0; i < kSamples; ++i) {
     const float a = l.lateral_min + (l.lateral_max - l.lateral_min) * (static_cast<float>(i) + 0.5f) / kSamples;
-    const Eigen::Vector3f p = r.T_camera_stair * Eigen::Vector3f(a, y, l.edge);
+    const Eigen::Vector3f p = r.T_camera_stair * Eigen::Vector3f(a, y, z);
     if (p.z() < 0.05f) {
       ++cut;
       continue;

@@ -52,6 +52,7 @@ void reset(StairResult& r, StairVerdict v, int candidates) {
   r.edge_right.setZero();
   r.method = StairAxesMethod::kNone;
   r.without_floor = false;
+  r.floor_remembered = false;
   r.level_data.clear();
   r.candidates = candidates;
   r.rejected_candidates = candidates;

@@ -227,11 +227,13 @@ struct StairDetectionConfig {
   float single_min_depth = 0.7f;       ///< m, a single level shallower than this is an obstacle
   float curb_min_depth = 2.6f;         ///< m, a single raised level deeper than this is another floor (curb)
   // Floorless route (stairs/floorless.hpp): stairs found when perception saw no floor.
-  bool floorless = false;              ///< look for stairs from the horizontal planes alone when there is no floor (off: see floorless.hpp)
+  bool floorless = true;               ///< look for stairs from the horizontal planes alone when there is no floor (floorless.hpp)
   float floorless_tilt_min = -0.17453293f;  ///< rad, lowest camera pitch below horizontal implied by the planes (-10 deg: about level)
   float floorless_tilt_max = 1.3962634f;    ///< rad, highest (80 deg: looking steeply down at the steps before the feet)
   int floorless_min_level_pixels = 500;     ///< px, smallest level (all its regions) of a floorless stack
   int floorless_min_levels = 2;             ///< levels one riser apart needed without a floor
+  float floorless_anchor_tolerance = 0.04f; ///< m, with the camera height remembered: the first level seen lies a whole number of risers from the feet within this
+  int floorless_max_hidden_steps = 1;       ///< with the camera height remembered: steps between the feet and the first level seen that may be out of view
 
   template <class V> void visit(V& v) {
     v.num(same_level_tolerance, "same_level_tolerance_cm", Unit::kCentimetre, 0.5, 20,
@@ -251,7 +253,8 @@ struct StairDetectionConfig {
     v.num(curb_min_depth, "curb_min_depth_m", Unit::kMetre, 0.1, 100,
           "a single raised level deeper than this, or running out of view on both sides and the far side, is another floor level (a curb)");
     v.flag(floorless, "floorless",
-           "without a floor, look for a stack of horizontal planes one riser apart (heights then relative, distance to the feet unknown)");
+           "without a floor, look for a stack of horizontal planes one riser apart (placed from the feet while the camera "
+           "height is remembered; otherwise heights relative, distance to the feet unknown)");
     v.num(floorless_tilt_min, "floorless_tilt_min_deg", Unit::kDegree, -90, 90,
           "floorless: lowest camera pitch below horizontal the horizontal planes may imply (negative: looking up)");
     v.num(floorless_tilt_max, "floorless_tilt_max_deg", Unit::kDegree, -90, 90,
@@ -260,6 +263,12 @@ struct StairDetectionConfig {
           "floorless: smallest level (all its regions), pixels");
     v.num(floorless_min_levels, "floorless_min_levels", Unit::kCount, 2, 100,
           "floorless: levels one riser apart needed to report a staircase");
+    v.num(floorless_anchor_tolerance, "floorless_anchor_tolerance_cm", Unit::kCentimetre, 0.5, 10,
+          "floorless with the camera height remembered: the first level seen must lie a whole number of risers from the "
+          "user's feet within this (else no staircase)");
+    v.num(floorless_max_hidden_steps, "floorless_max_hidden_steps", Unit::kCount, 0, 3,
+          "floorless with the camera height remembered: steps between the feet and the first level seen that may be out "
+          "of view (their edges placed from the seen ones)");
   }
 };
 

@@ -33,8 +33,25 @@
 ///     risers facing the user and the other edges, or stays unknown (0) when fewer than two edges
 ///     are seen.
 ///
-/// The result has `without_floor` set: heights are relative to the first seen level, and the
-/// distance from the user's feet (and whether that level is the first step) is unknown.
+/// *Remembered floor* (SceneResult::remembered_camera_height > 0: the floor was seen a moment ago
+/// and the camera's height above the user's feet is known): the feet lie that far below the camera
+/// along `up`, so each level's height is absolute. The first level seen (in stair order: the lowest
+/// ascending, the highest descending) must lie a whole number k of risers from the feet, within
+/// `floorless_anchor_tolerance`: k = 0 is the floor itself (level 0, its regions seen), k = 1 the
+/// first step, 2..1+`floorless_max_hidden_steps` a first level with the steps before it out of view
+/// (under the camera, at the feet), their edges placed one fitted tread apart before the first seen
+/// edge (the tread must then be measured). Any other stack is no staircase (kNoFirstStep). The
+/// result is a normal detection (`without_floor` false, `floor_remembered` set): heights from the
+/// floor, the origin on the first step's edge, the distance known.
+///
+/// *Cold start* (nothing remembered): the result has `without_floor` set: heights are relative to
+/// the first seen level, and the distance from the user's feet is unknown. The first level seen
+/// whose near boundary the image border cuts may be the floor the user stands on (the floor
+/// detector refused it) or the first step seen from above: deeper than the fitted tread (plus
+/// slack) and than a landing it is the floor and becomes level 0; seen at a chest camera's pitch
+/// (FloorConfig tilt range) from outside a chest camera's height above it (FloorConfig height
+/// range) it is a step; otherwise nothing says which, and no staircase is reported (kNoFirstStep)
+/// rather than one step off. A first level whose near boundary is in view is a step.
 ///
 /// Pure: no I/O, no exceptions; buffers are kept between frames.
 
@@ -59,7 +76,11 @@ struct FloorlessTrace {
   int levels = 0;                      ///< levels (height x connectivity groups) of the family
   int stacked = 0;                     ///< levels in the longest stack one riser apart
   int direction = 0;                   ///< +1 ascending, -1 descending, 0 undecided
-  bool floor_level = false;            ///< the lowest level was taken for the floor (deeper than a landing)
+  bool floor_level = false;            ///< the first seen level was taken for the floor (level 0)
+  bool anchored = false;               ///< the camera height was remembered: levels placed from the feet
+  int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
+  float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
+  bool first_near_cut = false;         ///< the first seen level's near boundary lies on the image border
   int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
   std::vector<float> level_heights;    ///< m, up . p of each stacked level, lowest first
 };
@@ -101,6 +122,14 @@ class FloorlessStairs {
   void model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0, StairResult& out);
   /// True when most of level k's edge line (at height y in the stair frame) lies on the image border.
   bool edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const;
+  /// The same for the line across level k at `z` along z_S.
+  bool line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y, float z) const;
+  /// Anchored to the remembered floor (see the file comment); `level0` is the stack's fitted level 0.
+  void run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser, float level0,
+                    StairResult& out);
+  /// Moves a model whose first level is step `hidden + 1` (steps 1..hidden out of view) so that its
+  /// origin, heights and indices count from the floor.
+  static void add_hidden_steps(StairResult& out, int dir, int hidden);
   /// Tread and origin from the edges seen inside the image and the risers; validation again.
   void refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
 

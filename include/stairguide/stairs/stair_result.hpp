@@ -75,6 +75,13 @@ struct StairResult {
   /// first seen level, heights are relative to it, and the distance from the user's feet (and
   /// whether the first seen level is the first step) is unknown.
   bool without_floor = false;
+  /// Found by the floorless route with no floor in view but the camera's height above the user's
+  /// feet remembered (SceneResult::remembered_camera_height): the floor is the plane that far below
+  /// the camera along the steps' own vertical, so heights, step indices, the first edge and the
+  /// distance are known as with a floor (`without_floor` is false). Level 0 is the floor (seen or
+  /// not); a first step out of view (at the feet) is placed one tread before the first seen edge
+  /// and the first seen level's index is then 2 (level_data[k].index counts from the floor).
+  bool floor_remembered = false;
   std::vector<StairLevel> level_data;     ///< floor first (index 0), then each step level in order
   int candidates = 0;                     ///< step candidates considered
   int rejected_candidates = 0;            ///< candidates left out as obstacles (tables, ...)
