@@ -7,9 +7,15 @@
 #include <numeric>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <opencv2/imgproc.hpp>
 
 namespace stairguide {
+
+namespace {
+/// A region is planar when its residual RMS is within this share of the inlier tolerance.
+constexpr float kPlanarRms = 0.6f;
+}  // namespace
 
 PlaneFit fit_plane_pca(const PointMoments& m) {
   PlaneFit f;
@@ -160,6 +166,7 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   un_.resize(static_cast<std::size_t>(W_));
   vn_.resize(static_cast<std::size_t>(H_));
   label_.assign(n, -1);
+  tried_.assign(n, 0);
   queue_.resize(n);
   const float ifx = 1.f / K_.fx, ify = 1.f / K_.fy;
   for (int u = 0; u < W_; ++u) un_[u] = (static_cast<float>(u) - K_.cx) * ifx;
@@ -170,7 +177,7 @@ void Segmentation::backproject(const RgbdFrame& frame) {
     const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(W_);
     for (int u = 0; u < W_; ++u) {
       float z = d[u];
-      if (!(z > 0.f) || !std::isfinite(z)) z = 0.f;
+      if (!(z > 0.f && z < 1e6f)) z = 0.f;  // no reading, NaN or infinite
       z_[row + u] = z;
       w_[row + u] = z > 0.f ? 1.f / z : 0.f;
 
@@ -241,6 +248,7 @@ bool Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, 
     // Too small to be a region, or grown on a dominant direction its pixels reject: give its
     // pixels back for later seeds and for clustering.
     for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
+    released_ = tail;
     g.count = 0;
     g.m = {};
     ++stats_.regions_dropped;
@@ -253,26 +261,31 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
   if (cell < 2) return;
   cells_.clear();
   const int need = (cell * cell * 4) / 5;
-  const int cs = std::max(2, cfg_.cell_size_px);
   for (int v0 = 0; v0 + cell <= H_; v0 += cell) {
     for (int u0 = 0; u0 + cell <= W_; u0 += cell) {
       // A fine cell wholly inside a coarse cell that joined a region has no free pixel left.
-      const int cu = u0 / cs, cv = v0 / cs;
-      if (cu == (u0 + cell - 1) / cs && cv == (v0 + cell - 1) / cs && cu < CW_ && cv < CH_ &&
+      const int cu = ucell_[u0], cv = vcell_[v0];
+      if (cu == ucell_[u0 + cell - 1] && cv == vcell_[v0 + cell - 1] && cu < CW_ && cv < CH_ &&
           cell_label_[static_cast<std::size_t>(cv * CW_ + cu)] >= 0)
         continue;
-      InvDepthMoments m;
+      // Count the free pixels first (integer work only): on real frames most fine cells left
+      // over are edges and speckle that fail here.
       int cnt = 0;
+      for (int v = v0; v < v0 + cell; ++v) {
+        const int* lab = &label_[static_cast<std::size_t>(v) * W_ + u0];
+        const float* z = &z_[static_cast<std::size_t>(v) * W_ + u0];
+        for (int i = 0; i < cell; ++i) cnt += (lab[i] == -1) & (z[i] > 0.f);
+      }
+      if (cnt < need) continue;
+      InvDepthMoments m;
       for (int v = v0; v < v0 + cell; ++v) {
         const int row = v * W_;
         for (int u = u0; u < u0 + cell; ++u) {
           const int p = row + u;
           if (label_[p] != -1 || z_[p] <= 0.f) continue;
           m.add(un_[u], vn_[v], w_[p]);
-          ++cnt;
         }
       }
-      if (cnt < need) continue;
       const PlaneFit f = fit_plane(m);
       if (!f.ok) continue;
       // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
@@ -289,14 +302,18 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
     // Re-fit on the pixels still free: an earlier region may have taken part of the cell.
     InvDepthMoments m;
     seed_pixels_.clear();
+    int tried = 0;
     for (int v = c.v0; v < c.v0 + cell; ++v)
       for (int u = c.u0; u < c.u0 + cell; ++u) {
         const int p = v * W_ + u;
         if (label_[p] != -1 || z_[p] <= 0.f) continue;
         seed_pixels_.push_back(p);
+        tried += tried_[p];
         m.add(un_[u], vn_[v], w_[p]);
       }
-    if (static_cast<int>(seed_pixels_.size()) < need) continue;
+    // Mostly on pixels a seed before already grew into a region too small to keep: clutter
+    // (real frames: hundreds of such seeds, each regrowing the same pixels).
+    if (static_cast<int>(seed_pixels_.size()) < need || 2 * tried > static_cast<int>(seed_pixels_.size())) continue;
     const PlaneFit f = fit_plane(m);
     if (!f.ok) continue;
     Grow g;
@@ -306,12 +323,16 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
     g.dir = best_direction(m, fc);
     g.plane = g.dir >= 0 ? fc : f;
     ++stats_.seeds_used;
+    released_ = 0;
     if (grow_region(static_cast<int>(grows.size()), seed_pixels_, g)) {
       // Its pixels reject the direction: the seed's own plane, then.
       g = Grow{};
       g.plane = f;
+      released_ = 0;
       grow_region(static_cast<int>(grows.size()), seed_pixels_, g);
     }
+    if (g.count == 0)
+      for (int i = 0; i < released_; ++i) tried_[static_cast<std::size_t>(queue_[i])] = 1;
     // Dropped regions stay as empty slots: ids are stable.
     grows.push_back(g);
   }
@@ -325,9 +346,19 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
   if (len < 2 || dirs_.empty()) return;
   cells_.clear();
   const int need = (2 * len * 3) / 4, need_row = len / 2;
-  const int cs = std::max(2, cfg_.cell_size_px);
   const float limit = 0.5f * tolerance_w();
   auto gather = [&](int u0, int v0, InvDepthMoments& m, std::vector<int>* pix) {
+    // Count the free pixels first (cheap): most windows on real frames fail here. Pixels a fine
+    // seed already grew into a too-small region (clutter) do not count.
+    for (int v = v0; v < v0 + 2; ++v) {
+      int cnt = 0;
+      const std::size_t row = static_cast<std::size_t>(v) * W_ + u0;
+      const int* lab = &label_[row];
+      const float* z = &z_[row];
+      const std::uint8_t* tried = &tried_[row];
+      for (int i = 0; i < len; ++i) cnt += (lab[i] == -1) & (z[i] > 0.f) & (tried[i] == 0);
+      if (cnt < need_row) return false;
+    }
     int rows_ok = 0;
     for (int v = v0; v < v0 + 2; ++v) {
       int cnt = 0;
@@ -344,10 +375,10 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
     return rows_ok == 2 && m.n >= need;
   };
   for (int v0 = 0; v0 + 2 <= H_; ++v0) {
-    const int cv0 = v0 / cs, cv1 = (v0 + 1) / cs;
+    const int cv0 = vcell_[v0], cv1 = vcell_[v0 + 1];
     for (int u0 = 0; u0 + len <= W_; u0 += len) {
       // Windows inside coarse cells that joined a region have no free pixel left.
-      const int cu0 = u0 / cs, cu1 = (u0 + len - 1) / cs;
+      const int cu0 = ucell_[u0], cu1 = ucell_[u0 + len - 1];
       if (cu0 == cu1 && cu0 < CW_ && cv1 < CH_ && cell_label_[static_cast<std::size_t>(cv0 * CW_ + cu0)] >= 0 &&
           cell_label_[static_cast<std::size_t>(cv1 * CW_ + cu0)] >= 0)
         continue;
@@ -385,12 +416,35 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
   CW_ = W_ / cs;
   CH_ = H_ / cs;
   const int nc = CW_ * CH_;
+  // Cell of each column / row (the later passes look these up instead of dividing per pixel).
+  ucell_.resize(static_cast<std::size_t>(W_));
+  vcell_.resize(static_cast<std::size_t>(H_));
+  for (int u = 0; u < W_; ++u) ucell_[u] = u / cs;
+  for (int v = 0; v < H_; ++v) vcell_[v] = v / cs;
   cell_m_.assign(static_cast<std::size_t>(nc), InvDepthMoments{});
   cell_label_.assign(static_cast<std::size_t>(nc), -1);
   cell_planar_.assign(static_cast<std::size_t>(nc), 0);
   cells_.clear();
   const int need = (cs * cs * 4) / 5;
   const float limit = 0.5f * tolerance_w();
+  // Offsets of the normalised coordinates inside a cell, and their sums over a full cell.
+  std::vector<float>& gu = gu_;
+  std::vector<float>& gv = gv_;
+  gu.resize(static_cast<std::size_t>(cs));
+  gv.resize(static_cast<std::size_t>(cs));
+  float full[5] = {0, 0, 0, 0, 0};  // Su, Sv, Suu, Suv, Svv
+  for (int i = 0; i < cs; ++i) {
+    gu[i] = static_cast<float>(i) / K_.fx;
+    gv[i] = static_cast<float>(i) / K_.fy;
+  }
+  for (int j = 0; j < cs; ++j)
+    for (int i = 0; i < cs; ++i) {
+      full[0] += gu[i];
+      full[1] += gv[j];
+      full[2] += gu[i] * gu[i];
+      full[3] += gu[i] * gv[j];
+      full[4] += gv[j] * gv[j];
+    }
   for (int cv = 0; cv < CH_; ++cv) {
     for (int cu = 0; cu < CW_; ++cu) {
       InvDepthMoments& m = cell_m_[static_cast<std::size_t>(cv * CW_ + cu)];
@@ -406,17 +460,35 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
             break;
           }
       if (w0 == 0.f) continue;
-      float n = 0, Su = 0, Sv = 0, Sw = 0, Suu = 0, Suv = 0, Svv = 0, Suw = 0, Svw = 0, Sww = 0;
+      // Sums with w first: an invalid pixel has dw = 0, so only the count needs the mask there.
+      float n = 0, Sw = 0, Suw = 0, Svw = 0, Sww = 0;
       for (int v = v0; v < v0 + cs; ++v) {
-        const float dv = vn_[v] - vc;
-        const float* w = &w_[static_cast<std::size_t>(v) * W_];
-        for (int u = u0; u < u0 + cs; ++u) {
-          const float ok = w[u] > 0.f ? 1.f : 0.f;
-          const float du = (un_[u] - uc) * ok, dvv = dv * ok, dw = (w[u] - w0) * ok;
+        const float dv = gv[v - v0];
+        const float* w = &w_[static_cast<std::size_t>(v) * W_ + u0];
+        for (int i = 0; i < cs; ++i) {
+          const float ok = w[i] > 0.f ? 1.f : 0.f;
+          const float dw = (w[i] - w0) * ok;
           n += ok;
-          Su += du; Sv += dvv; Sw += dw;
-          Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
-          Suw += du * dw; Svw += dvv * dw; Sww += dw * dw;
+          Sw += dw;
+          Suw += gu[i] * dw;
+          Svw += dv * dw;
+          Sww += dw * dw;
+        }
+      }
+      if (n < need) continue;
+      // The pixel-coordinate sums: those of a full cell (most cells), else summed over the valid.
+      float Su = full[0], Sv = full[1], Suu = full[2], Suv = full[3], Svv = full[4];
+      if (n < static_cast<float>(cs * cs)) {
+        Su = Sv = Suu = Suv = Svv = 0.f;
+        for (int v = v0; v < v0 + cs; ++v) {
+          const float dv = gv[v - v0];
+          const float* w = &w_[static_cast<std::size_t>(v) * W_ + u0];
+          for (int i = 0; i < cs; ++i) {
+            const float ok = w[i] > 0.f ? 1.f : 0.f;
+            const float du = gu[i] * ok, dvv = dv * ok;
+            Su += du; Sv += dvv;
+            Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
+          }
         }
       }
       const double U = uc, V = vc, Wc = w0;
@@ -430,7 +502,6 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
       m.suw = Suw + U * Sw + Wc * Su + n * U * Wc;
       m.svw = Svw + V * Sw + Wc * Sv + n * V * Wc;
       m.sww = Sww + 2 * Wc * Sw + n * Wc * Wc;
-      if (m.n < need) continue;
       const PlaneFit f = fit_plane(m);
       // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
       if (!f.ok || f.rms_w > limit) continue;
@@ -553,12 +624,29 @@ int find_root(std::vector<int>& parent, int a) {
 
 void Segmentation::merge_regions(std::vector<Grow>& grows) {
   const int n = static_cast<int>(grows.size());
-  if (n < 2 || n > 4096) return;
+  // Dropped seeds leave empty slots (often most of them on cluttered real frames): the pair
+  // tables below are over the live regions only.
+  std::vector<int>& cid = cid_;
+  std::vector<int>& live = live_;
+  cid.assign(static_cast<std::size_t>(n), -1);
+  live.clear();
+  for (int r = 0; r < n; ++r)
+    if (grows[r].count > 0) cid[r] = static_cast<int>(live.size()), live.push_back(r);
+  const int m = static_cast<int>(live.size());
+  seams_.clear();
+  if (m < 2 || m > 4096) return;
   std::vector<std::uint8_t>& adj = mask_;
-  adj.assign(static_cast<std::size_t>(n) * n, 0);
-  auto mark = [&](int a, int b) {
-    if (a < 0 || b < 0 || a == b) return;
-    adj[static_cast<std::size_t>(std::min(a, b)) * n + std::max(a, b)] = 1;
+  adj.assign(static_cast<std::size_t>(m) * m, 0);
+  // The seam samples (pixel pairs of two regions) are kept for drop_curved_tiles.
+  std::vector<int>& seams = seams_;
+  seams.clear();
+  auto mark = [&](int p, int q) {
+    const int a = label_[p], b = label_[q];
+    if (b < 0 || a == b) return;
+    seams.push_back(p);
+    seams.push_back(q);
+    const int ca = cid[a], cb = cid[b];
+    adj[static_cast<std::size_t>(std::min(ca, cb)) * m + std::max(ca, cb)] = 1;
   };
   // Regions touching directly or across a one-pixel gap of unassigned (noisy) pixels. Every
   // other row and column is enough to see two regions that share a border.
@@ -569,31 +657,33 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
       if (a < 0) continue;
       if (u + 1 < W_) {
         const int b = label_[p + 1];
-        if (b >= 0) mark(a, b);
-        else if (u + 2 < W_) mark(a, label_[p + 2]);
+        if (b >= 0) {
+          if (b != a) mark(p, p + 1);
+        } else if (u + 2 < W_) {
+          mark(p, p + 2);
+        }
       }
       if ((u & 1) == 0 && v + 1 < H_) {
         const int b = label_[p + W_];
-        if (b >= 0) mark(a, b);
-        else if (v + 2 < H_) mark(a, label_[p + 2 * W_]);
+        if (b >= 0) {
+          if (b != a) mark(p, p + W_);
+        } else if (v + 2 < H_) {
+          mark(p, p + 2 * W_);
+        }
       }
     }
   }
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   const float cos_max = std::cos(2.f * cfg_.region_angle);
-  for (int a = 0; a < n; ++a) {
-    for (int b = a + 1; b < n; ++b) {
-      if (!adj[static_cast<std::size_t>(a) * n + b]) continue;
-      const int ra = find_root(parent, a), rb = find_root(parent, b);
+  for (int ca = 0; ca < m; ++ca) {
+    for (int cb = ca + 1; cb < m; ++cb) {
+      if (!adj[static_cast<std::size_t>(ca) * m + cb]) continue;
+      const int ra = find_root(parent, live[ca]), rb = find_root(parent, live[cb]);
       if (ra == rb || grows[ra].count == 0 || grows[rb].count == 0) continue;
       const PlaneFit& pa = grows[ra].plane;
       const PlaneFit& pb = grows[rb].plane;
       if (pa.normal.dot(pb.normal) < cos_max) continue;
-      // Each part's mean residual under the other's plane within the noise.
-      const double ra_b = grows[rb].m.mean_residual(pa.a, pa.b, pa.c);
-      const double rb_a = grows[ra].m.mean_residual(pb.a, pb.b, pb.c);
-      if (std::fabs(ra_b) > tolerance_w() || std::fabs(rb_a) > tolerance_w()) continue;
       InvDepthMoments m = grows[ra].m;
       m.add(grows[rb].m);
       // A part grown on a dominant direction keeps it while the union does not reject it.
@@ -601,8 +691,19 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
       if (grows[rb].dir >= 0 && (dir < 0 || grows[rb].count > grows[ra].count)) dir = grows[rb].dir;
       const PlaneFit f = region_plane(m, dir);
       if (!f.ok) continue;
+      // Each part's mean residual under the union's plane within the noise. (Not under the
+      // other part's plane: a small part's tilt is poorly fixed, and extrapolated over a big
+      // neighbour it misses by many sigmas. On real frames that split every floor and wall into
+      // a big region and a fringe of patches a few centimetres "off" it.) A step between the
+      // parts shows here (the smaller part sits off the union plane) or in the residual below.
+      if (std::fabs(grows[ra].m.mean_residual(f.a, f.b, f.c)) > tolerance_w() ||
+          std::fabs(grows[rb].m.mean_residual(f.a, f.b, f.c)) > tolerance_w())
+        continue;
       // One plane must explain both parts about as well as each part's own plane does.
-      if (f.rms_w > 1.25f * std::max(pa.rms_w, pb.rms_w) + 0.25f * cfg_.depth_noise_coeff) continue;
+      // (And no merge into what the planarity check of finalize would then drop whole.)
+      if (f.rms_w > 1.25f * std::max(pa.rms_w, pb.rms_w) + 0.25f * cfg_.depth_noise_coeff ||
+          f.rms_w > kPlanarRms * tolerance_w())
+        continue;
       parent[rb] = ra;
       grows[ra].m = m;
       grows[ra].plane = f;
@@ -614,8 +715,126 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
   }
   if (stats_.regions_merged == 0) return;
   for (int r = 0; r < n; ++r) parent[r] = find_root(parent, r);
-  for (int& l : label_)
-    if (l >= 0) l = parent[l];
+  // Relabel. The valid pixels of a region cell all carry the cell's label (the passes after the
+  // cell pass take only free pixels): a cell of an unmerged region is skipped whole.
+  const int cs = std::max(2, cfg_.cell_size_px);
+  for (int v = 0; v < H_; ++v) {
+    int* lab = &label_[static_cast<std::size_t>(v) * W_];
+    const int cv = vcell_[v];
+    for (int u = 0, cu = 0; u < W_; ++cu) {
+      const int cl = cv < CH_ && cu < CW_ ? cell_label_[static_cast<std::size_t>(cv * CW_ + cu)] : -1;
+      const int ue = cu < CW_ ? u + cs : W_;
+      if (cl >= 0 && parent[cl] == cl) {
+        u = ue;
+        continue;
+      }
+      for (; u < ue; ++u)
+        if (lab[u] >= 0) lab[u] = parent[lab[u]];
+    }
+  }
+  for (int& cl : cell_label_)
+    if (cl >= 0) cl = parent[cl];
+}
+
+void Segmentation::drop_curved_tiles(std::vector<Grow>& grows) {
+  // Region growing with a noise-sized inlier test tiles a curved surface (a person's back, a bag)
+  // into facets a few noise widths deep: each is planar within the noise, so the planarity check
+  // passes, and a corridor with five people came out as ~300 "planes". The paper's route does not
+  // see them (normals vary smoothly, its growing follows the curve and RANSAC then rejects the
+  // whole). The facets are recognised by their seams instead: two regions meeting without a depth
+  // jump (both planes pass through the seam) at a small angle are bends of one surface, whereas
+  // planes of the built world meet at creases of about 90 degrees (tread/riser, wall/floor) or
+  // at occlusion edges (a depth jump).
+  if (!(cfg_.curved_tile_max_area > 0.f)) return;
+  const int ng = static_cast<int>(grows.size());
+  std::vector<int>& cid = cid_;  // grown region -> index among the live ones (-1: empty slot)
+  std::vector<int>& live = live_;
+  cid.assign(static_cast<std::size_t>(ng), -1);
+  live.clear();
+  for (int r = 0; r < ng; ++r)
+    if (grows[r].count > 0 && grows[r].plane.ok) cid[r] = static_cast<int>(live.size()), live.push_back(r);
+  const int n = static_cast<int>(live.size());
+  if (n < 2 || n > 4096) return;
+  // Candidates: small regions not parallel to a big one (treads, risers, floor and wall pieces
+  // are parallel to the floor or a wall; a facet of a curve generally is not). The directions
+  // come from the big regions here, not from dirs_: facets of a near person pass the dominant
+  // size in pixels.
+  std::vector<std::uint8_t>& cand = cell_planar_;  // no longer needed after the cell pass
+  cand.assign(static_cast<std::size_t>(n), 0);
+  std::vector<float>& area = area_;
+  area.assign(static_cast<std::size_t>(n), 0.f);
+  const float area_k = 1.f / (K_.fx * K_.fy);
+  std::vector<Eigen::Vector3f>& big = big_dirs_;
+  big.clear();
+  const float par = std::cos(5.f * 3.14159265f / 180.f);
+  for (int r = 0; r < n; ++r) {
+    const Grow& g = grows[live[r]];
+    // Pixel footprint on the plane z^3 / (fx fy d), at the region's mean pixel.
+    const float z = g.plane.mean.z();
+    area[r] = static_cast<float>(g.count) * z * z * z * area_k / std::max(g.plane.d, 0.01f);
+    if (area[r] < cfg_.curved_tile_max_area && g.dir < 0) {
+      cand[r] = 1;
+      continue;
+    }
+    bool dup = false;
+    for (const Eigen::Vector3f& d : big) dup |= d.dot(g.plane.normal) > par;
+    if (!dup && big.size() < 32) big.push_back(g.plane.normal);
+  }
+  int ncand = 0;
+  for (int r = 0; r < n; ++r) {
+    if (!cand[r]) continue;
+    for (const Eigen::Vector3f& d : big) cand[r] &= d.dot(grows[live[r]].plane.normal) <= par;
+    ncand += cand[r];
+  }
+  if (ncand == 0) return;
+  const std::size_t nn = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  contact_.assign(nn, 0);
+  smooth_.assign(nn, 0);
+  const float tw = tolerance_w();
+  // The seam samples of merge_regions (pixel pairs of two regions, labels now merged).
+  for (std::size_t i = 0; i + 1 < seams_.size(); i += 2) {
+    const int p = seams_[i], q = seams_[i + 1];
+    const int la = label_[p], lb = label_[q];
+    if (la == lb || la < 0 || lb < 0) continue;
+    const int a = cid[la], b = cid[lb];
+    if (a < 0 || b < 0 || !(cand[a] | cand[b])) continue;
+    const std::size_t k = static_cast<std::size_t>(std::min(a, b)) * n + static_cast<std::size_t>(std::max(a, b));
+    if (contact_[k] == 0xFFFF) continue;
+    ++contact_[k];
+    // Both planes pass through the seam: no depth jump between the two regions there.
+    const PlaneFit& pa = grows[la].plane;
+    const PlaneFit& pb = grows[lb].plane;
+    const int vp = row_of(p), up = p - vp * W_, vq = row_of(q), uq = q - vq * W_;
+    const float ra = w_[q] - (pa.a * un_[uq] + pa.b * vn_[vq] + pa.c);
+    const float rb = w_[p] - (pb.a * un_[up] + pb.b * vn_[vp] + pb.c);
+    smooth_[k] += std::fabs(ra) <= tw && std::fabs(rb) <= tw;
+  }
+  // A candidate bending into another candidate, or into two regions, is a facet: a lone tilted
+  // patch against one big plane (a rounded nosing, a sign) is kept.
+  const float cos_bend = std::cos(cfg_.curved_bend_max_angle);
+  const float cos_parallel = std::cos(2.f * cfg_.region_angle);
+  std::vector<int>& bends = sorted_;
+  bends.assign(static_cast<std::size_t>(2 * n), 0);  // [2r]: bends to candidates, [2r+1]: all bends
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      const std::size_t k = static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b);
+      const int c = contact_[k];
+      if (c < 4 || 2 * smooth_[k] < c) continue;
+      // Nearly parallel neighbours (within the merge angle) are one plane that failed to merge
+      // or parallel planes, not a bend.
+      const float cosab = grows[live[a]].plane.normal.dot(grows[live[b]].plane.normal);
+      if (cosab < cos_bend || cosab > cos_parallel) continue;
+      bends[2 * a] += cand[b];
+      bends[2 * a + 1] += 1;
+      bends[2 * b] += cand[a];
+      bends[2 * b + 1] += 1;
+    }
+  }
+  for (int r = 0; r < n; ++r) {
+    if (!cand[r] || (bends[2 * r] < 1 && bends[2 * r + 1] < 2)) continue;
+    grows[live[r]].count = 0;  // finalize clears its labels: the pixels go to the obstacle clusters
+    ++stats_.curved_tiles;
+  }
 }
 
 void Segmentation::refine_borders(std::vector<Grow>& grows) {
@@ -628,30 +847,33 @@ void Segmentation::refine_borders(std::vector<Grow>& grows) {
   // Edges between planes run through the cells that were not planar (whole planar cells went to
   // one region), and through the image margin outside the cell grid.
   const int cs = std::max(2, cfg_.cell_size_px);
-  for (int v = 0; v < H_; ++v) {
-    const int cv = v / cs;
-    for (int u = 0; u < W_; ++u) {
-      const int cu = u / cs;
+  for (int v = 0, cv = 0, vr = 0; v < H_; ++v) {
+    // (cv, cu): the pixel's cell, stepped along without divisions (this scans every pixel).
+    for (int u = 0, cu = 0; u < W_; cu++) {
       if (cv < CH_ && cu < CW_ && cell_label_[cv * CW_ + cu] >= 0) {
-        u = (cu + 1) * cs - 1;  // skip the rest of this region cell
+        u += cs;  // a region cell: its inside is one region
         continue;
       }
-      const int p = v * W_ + u;
-      const int a = label_[p];
-      if (a < 0) continue;
-      if ((u + 1 < W_ && label_[p + 1] >= 0 && label_[p + 1] != a) ||
-          (u > 0 && label_[p - 1] >= 0 && label_[p - 1] != a) ||
-          (v + 1 < H_ && label_[p + W_] >= 0 && label_[p + W_] != a) ||
-          (v > 0 && label_[p - W_] >= 0 && label_[p - W_] != a))
-        cur.push_back(p);
+      const int ue = cu < CW_ ? u + cs : W_;
+      for (; u < ue; ++u) {
+        const int p = v * W_ + u;
+        const int a = label_[p];
+        if (a < 0) continue;
+        if ((u + 1 < W_ && label_[p + 1] >= 0 && label_[p + 1] != a) ||
+            (u > 0 && label_[p - 1] >= 0 && label_[p - 1] != a) ||
+            (v + 1 < H_ && label_[p + W_] >= 0 && label_[p + W_] != a) ||
+            (v > 0 && label_[p - W_] >= 0 && label_[p - W_] != a))
+          cur.push_back(p);
+      }
     }
+    if (++vr == cs) vr = 0, ++cv;
   }
   const float kl = 1.41421356f * tolerance_w();
   for (int iter = 0; iter < 8 && !cur.empty(); ++iter) {
     nxt.clear();
     for (int p : cur) {
       const int a = label_[p];
-      if (a < 0) continue;
+      if (a < 0 || grows[a].count <= 0) continue;  // dropped regions' pixels go to the clusters
       const int v = row_of(p), u = p - v * W_;
       const float wp = w_[p];
       const PlaneFit& pa = grows[a].plane;
@@ -702,7 +924,7 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
     if (g.count < cfg_.region_min_pixels) continue;
     // Border refinement moved pixels: the direction is checked again on the final moments.
     const PlaneFit f = region_plane(g.m, g.dir);
-    if (!f.ok || f.rms_w > 0.6f * tolerance_w()) {
+    if (!f.ok || f.rms_w > kPlanarRms * tolerance_w()) {
       ++stats_.regions_dropped;
       continue;
     }
@@ -823,9 +1045,14 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
 
 void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
   const int N = W_ * H_;
-  mask_.assign(static_cast<std::size_t>(N), 0);
-  for (int p = 0; p < N; ++p)
-    if (label_[p] == -1 && z_[p] > 0.f) mask_[p] = 255;
+  mask_.resize(static_cast<std::size_t>(N));
+  {
+    // Branch-free (vectorised): on real frames a third of the pixels may be left to clusters.
+    const int* L = label_.data();
+    const float* Z = z_.data();
+    std::uint8_t* M = mask_.data();
+    for (int p = 0; p < N; ++p) M[p] = static_cast<std::uint8_t>(((L[p] == -1) & (Z[p] > 0.f)) * 255);
+  }
   // Erosion removes the one- or two-pixel seams left between planes (step edges): they are not
   // objects, and without it they would chain whole staircases into one "obstacle".
   cv::Mat m(H_, W_, CV_8UC1, mask_.data());
@@ -833,7 +1060,10 @@ void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
   const int stride = std::max(1, cfg_.points_stride_px);
   std::size_t out = 0;
   for (int s = 0; s < N; ++s) {
-    if (mask_[s] != 255) continue;
+    // Next unvisited obstacle pixel (memchr scans in vector steps).
+    const void* hit = std::memchr(mask_.data() + s, 255, static_cast<std::size_t>(N - s));
+    if (!hit) break;
+    s = static_cast<int>(static_cast<const std::uint8_t*>(hit) - mask_.data());
     const int cid = static_cast<int>(out);
     int head = 0, tail = 0;
     queue_[tail++] = s;
@@ -908,11 +1138,15 @@ bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions
   grows_.clear();
   cell_pass(grows_);
   find_dominant_directions(grows_);
+  stats_.cells_ms = lap();
   if (cfg_.fine_cell_size_px > 1 && cfg_.fine_cell_size_px < cfg_.cell_size_px)
     seed_pass(cfg_.fine_cell_size_px, grows_);
+  stats_.seeds_ms = lap();
   strip_pass(grows_);
-  stats_.grow_ms = lap();
+  stats_.strips_ms = lap();
+  stats_.grow_ms = stats_.cells_ms + stats_.seeds_ms + stats_.strips_ms;
   merge_regions(grows_);
+  drop_curved_tiles(grows_);
   stats_.merge_ms = lap();
   refine_borders(grows_);
   stats_.refine_ms = lap();

@@ -76,6 +76,8 @@ struct SegmentationConfig {
   int points_stride_px = 2;          ///< px, PlaneRegion::points keeps every Nth pixel in u and v
   float dominant_min_fraction = 0.01f;  ///< share of the valid pixels a region needs for its normal to be a dominant direction
   int strip_length_px = 8;           ///< px, columns of the 2-row windows seeding thin strips on dominant directions (0: off)
+  float curved_tile_max_area = 0.15f;  ///< m^2, regions smaller than this, bent smoothly into their neighbours, are tiles of a curved surface (0: off)
+  float curved_bend_max_angle = 0.6981317f;  ///< rad, a smooth (depth-continuous) seam between two regions at most this angle apart is a bend (40 deg)
 
   template <class V> void visit(V& v) {
     v.num(voxel_size, "voxel_size_cm", Unit::kCentimetre, 0.5, 20, "voxel grid edge (paper: 3-4 cm)");
@@ -103,6 +105,11 @@ struct SegmentationConfig {
           "share of the valid pixels a region needs for its normal to be a dominant direction");
     v.num(strip_length_px, "strip_length_px", Unit::kPixel, 0, 64,
           "columns of the 2-row windows that seed thin strips (far treads) on a dominant direction; 0 = off");
+    v.num(curved_tile_max_area, "curved_tile_max_area_m2", Unit::kNone, 0, 10,
+          "m^2: a region smaller than this, not parallel to a dominant direction, that bends smoothly into other regions "
+          "is a facet of a curved surface (a person, a bag) and goes to the obstacles; 0 = off");
+    v.num(curved_bend_max_angle, "curved_bend_max_angle_deg", Unit::kDegree, 1, 89,
+          "largest angle between two regions meeting without a depth jump that counts as a bend of one curved surface");
   }
 };
 

@@ -19,9 +19,14 @@
 ///     lies on a plane parallel to one, within the noise, grows with that normal fixed and only
 ///     its offset fitted; it keeps the fixed normal only while its pixels do not reject it (its
 ///     free fit is not clearly better);
-///  5. adjacent regions on one plane are merged; border pixels go to the plane that fits them best;
-///     regions whose residual is not noise-like are dropped; area (pixel footprints on the plane),
-///     principal rectangle, extent and curvature are computed;
+///  5. adjacent regions on one plane are merged (each part's mean residual under the union's
+///     plane within the noise: a small part's own tilt is too rough to extrapolate over a big
+///     neighbour); small regions that bend smoothly (no depth jump, normals between the merge
+///     angle and `curved_bend_max_angle` apart) into other such regions are facets of a curved
+///     surface (people, bags, cushions: region growing with a noise-sized inlier test tiles
+///     them) and go to the obstacles, unless parallel to a big region; border pixels go to the
+///     plane that fits them best; regions whose residual is not noise-like are dropped; area
+///     (pixel footprints on the plane), principal rectangle, extent and curvature are computed;
 ///  6. the remaining pixels (eroded) form obstacle clusters (image connectivity + depth jumps).
 /// No threads; buffers are kept between frames of one size.
 
@@ -100,9 +105,11 @@ struct SegmentationStats {
   int border_pixels_moved = 0;  ///< pixels handed to the neighbouring region whose plane fits better
   /// Milliseconds per step (for `stairguide bench perception`).
   double backproject_ms = 0, grow_ms = 0, merge_ms = 0, refine_ms = 0, finalize_ms = 0, clusters_ms = 0;
+  double cells_ms = 0, seeds_ms = 0, strips_ms = 0;  ///< parts of grow_ms: cell pass, fine seeds, strip seeds
   int regions_dropped = 0;  ///< grown regions below region_min_pixels or failing the planarity check
   int dominant_directions = 0;  ///< normals the thin-strip seeds may take
   int fixed_normal_regions = 0;  ///< regions grown with a dominant direction's normal
+  int curved_tiles = 0;  ///< small regions dropped as facets of a curved surface
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -142,6 +149,7 @@ class Segmentation {
   PlaneFit region_plane(const InvDepthMoments& m, int& dir) const;
   void strip_pass(std::vector<Grow>& grows);
   void merge_regions(std::vector<Grow>& grows);
+  void drop_curved_tiles(std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
   void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
   void extract_clusters(std::vector<ObstacleCluster>& clusters);
@@ -163,6 +171,8 @@ class Segmentation {
   std::vector<float> z_;           // depth, 0 where no reading (x = u' z, y = v' z)
   std::vector<float> w_;           // 1/z, 0 where no reading
   std::vector<float> un_, vn_;     // normalised image coordinates per column / row
+  std::vector<float> gu_, gv_;     // offsets of the normalised coordinates inside a cell
+  std::vector<int> ucell_, vcell_; // cell column / row of each image column / row
   std::vector<int> label_;
   std::vector<int> queue_;
   std::vector<int> seed_pixels_, next_;
@@ -182,8 +192,14 @@ class Segmentation {
   std::vector<InvDepthMoments> cell_m_;
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
-  std::vector<int> order_, offsets_, sorted_;
+  std::vector<int> order_, offsets_, sorted_, cid_, live_;
+  std::vector<int> seams_;  // pixel pairs (p, q) on the borders between regions, from merge_regions
   std::vector<std::uint8_t> mask_;
+  std::vector<std::uint8_t> tried_;  // fine seed pass: pixel was in a grown region that was too small
+  int released_ = 0;                 // pixels (queue_[0..n)) released by the last dropped grow_region
+  std::vector<std::uint16_t> contact_, smooth_;
+  std::vector<float> area_;
+  std::vector<Eigen::Vector3f> big_dirs_;  // region pairs: seam samples, depth-continuous ones
   std::vector<Eigen::Vector3f> dirs_;  // dominant directions (unit normals facing the camera)
   SegmentationStats stats_;
 };

@@ -1,9 +1,12 @@
-// `stairguide bench perception [--frames DIR] [--count N] [--json]`: segmentation + floor +
+// `stairguide bench perception [--frames INPUT] [--count N] [--json]`: segmentation + floor +
 // Manhattan + classification per frame, against a reference built from PCL's own classes with the
 // paper's parameters (section 3.1: VoxelGrid 4 cm, NormalEstimation r = 5 cm, RegionGrowing
 // 6 deg / 0.5 / 50, RANSAC planarity > 80 %, EuclideanClusterExtraction), on the same frames in
 // the same process, one thread. Wall time (steady clock) and thread CPU time are both reported:
 // on a shared machine the CPU time is the steadier of the two.
+// INPUT: anything `analyze` reads (a dataset folder, FILE.oni, FILE.pcd, ...), a folder of .pcd
+// frames, or a list file (.txt / .list: one such input per line, relative to the list, # for
+// comments), so that single real frames can be benchmarked together.
 #include <pcl/features/normal_3d.h>
 #include <pcl/filters/extract_indices.h>
 #include <pcl/filters/voxel_grid.h>
@@ -20,6 +23,8 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -131,6 +136,39 @@ struct Reference {
   }
 };
 
+/// The inputs `--frames ARG` names (see the file comment). Throws UsageError naming the file and
+/// line when a list is unreadable or names nothing that exists.
+std::vector<std::string> frame_inputs(const std::string& arg) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(arg, ec)) {
+    std::vector<std::string> pcds;
+    for (const auto& e : fs::directory_iterator(arg, ec))
+      if (e.is_regular_file() && e.path().extension() == ".pcd") pcds.push_back(e.path().string());
+    std::sort(pcds.begin(), pcds.end());
+    if (!pcds.empty()) return pcds;
+    return {arg};  // a dataset folder
+  }
+  const std::string ext = fs::path(arg).extension().string();
+  if (ext != ".txt" && ext != ".list") return {arg};
+  std::ifstream in(arg);
+  if (!in) throw UsageError("--frames " + arg + ": cannot read this list file");
+  std::vector<std::string> out;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    const auto b = line.find_first_not_of(" \t\r");
+    if (b == std::string::npos || line[b] == '#') continue;
+    const auto e = line.find_last_not_of(" \t\r");
+    fs::path p(line.substr(b, e - b + 1));
+    if (p.is_relative()) p = fs::path(arg).parent_path() / p;
+    if (!fs::exists(p, ec))
+      throw UsageError("--frames " + arg + " line " + std::to_string(n) + ": '" + p.string() + "' does not exist");
+    out.push_back(p.string());
+  }
+  if (out.empty()) throw UsageError("--frames " + arg + ": the list names no input");
+  return out;
+}
+
 int bench_perception(Context& ctx) {
   const bool json = ctx.flag("--json");
   const auto dir = ctx.option("--frames");
@@ -139,16 +177,28 @@ int bench_perception(Context& ctx) {
 
   std::vector<RgbdFrame> frames;
   if (dir) {
-    auto src = open_frame_source(*dir, ctx.config.capture);
-    RgbdFrame f;
     const long limit = count > 0 ? count : 30;
-    while (static_cast<long>(frames.size()) < limit) {
-      const ReadResult r = src->read(f);
-      if (!r.ok()) {
-        if (r.status == ReadStatus::kError) std::fprintf(stderr, "stairguide bench perception: %s\n", r.message.c_str());
-        break;
+    for (const std::string& input : frame_inputs(*dir)) {
+      std::unique_ptr<FrameSource> src;
+      try {
+        src = open_frame_source(input, ctx.config.capture);
+      } catch (const SourceError& e) {
+        std::fprintf(stderr, "stairguide bench perception: %s\n", e.what());
+        return 1;
       }
-      frames.push_back(f.clone());
+      RgbdFrame f;
+      while (static_cast<long>(frames.size()) < limit) {
+        const ReadResult r = src->read(f);
+        if (!r.ok()) {
+          if (r.status == ReadStatus::kError) {
+            std::fprintf(stderr, "stairguide bench perception: %s\n", r.message.c_str());
+            return 1;
+          }
+          break;
+        }
+        frames.push_back(f.clone());
+      }
+      if (static_cast<long>(frames.size()) >= limit) break;
     }
   } else {
     const long per = count > 0 ? count : 8;
@@ -167,7 +217,7 @@ int bench_perception(Context& ctx) {
   SceneResult scene;
   ours.process(frames[0], scene);  // warm-up: buffers reach their size
   std::vector<double> o_wall, o_cpu, o_seg, o_floor, o_man, o_cls;
-  std::vector<double> s_bp, s_grow, s_merge, s_refine, s_fin, s_cl;
+  std::vector<double> s_bp, s_grow, s_merge, s_refine, s_fin, s_cl, o_regions, r_regions;
   int floors = 0;
   for (const auto& f : frames) {
     ours.reset();
@@ -187,6 +237,7 @@ int bench_perception(Context& ctx) {
     s_fin.push_back(st.finalize_ms);
     s_cl.push_back(st.clusters_ms);
     floors += scene.floor_found;
+    o_regions.push_back(static_cast<double>(scene.regions.size()));
   }
 
   Reference ref;
@@ -221,6 +272,7 @@ int bench_perception(Context& ctx) {
     r_ransac.push_back(ref.ransac_ms);
     r_clu.push_back(ref.clusters_ms);
     ref_floors += fe.found;
+    r_regions.push_back(static_cast<double>(rs.regions.size()));
   }
   const double med = percentile(o_wall, 0.5), p95 = percentile(o_wall, 0.95);
   const double rmed = percentile(r_wall, 0.5), rp95 = percentile(r_wall, 0.95);
@@ -235,23 +287,24 @@ int bench_perception(Context& ctx) {
                 "\"ours_classification_median_ms\": %.3f, \"reference_voxel_median_ms\": %.3f, "
                 "\"reference_normals_median_ms\": %.3f, \"reference_growing_median_ms\": %.3f, "
                 "\"reference_ransac_median_ms\": %.3f, \"reference_clusters_median_ms\": %.3f, "
-                "\"ours_floor_found\": %d, \"reference_floor_found\": %d}\n",
+                "\"ours_floor_found\": %d, \"reference_floor_found\": %d, \"ours_regions_median\": %.0f, "
+                "\"reference_regions_median\": %.0f}\n",
                 frames.size(), W, H, med, p95, cmed, cp95, rmed, rp95, rcmed, ratio, cratio, percentile(o_seg, 0.5),
                 percentile(o_floor, 0.5), percentile(o_man, 0.5), percentile(o_cls, 0.5), percentile(r_vox, 0.5),
                 percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5), percentile(r_clu, 0.5),
-                floors, ref_floors);
+                floors, ref_floors, percentile(o_regions, 0.5), percentile(r_regions, 0.5));
     return 0;
   }
   std::printf("perception bench: %zu frames %dx%d, one thread\n", frames.size(), W, H);
-  std::printf("  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d\n", med,
-              p95, cmed, cp95, floors);
+  std::printf("  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d | regions median %.0f\n", med,
+              p95, cmed, cp95, floors, percentile(o_regions, 0.5));
   std::printf("    segmentation %.3f (backproject %.3f, seeds+growing %.3f, merge %.3f, borders %.3f, regions %.3f, "
               "clusters %.3f)  floor %.3f  manhattan %.3f  classification %.3f\n",
               percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_merge, 0.5),
               percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
               percentile(o_man, 0.5), percentile(o_cls, 0.5));
-  std::printf("  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d\n", rmed, rp95, rcmed,
-              ref_floors);
+  std::printf("  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d | regions median %.0f\n", rmed,
+              rp95, rcmed, ref_floors, percentile(r_regions, 0.5));
   std::printf("    voxel %.3f  normals %.3f  region growing %.3f  ransac %.3f  euclidean clusters %.3f\n",
               percentile(r_vox, 0.5), percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5),
               percentile(r_clu, 0.5));
@@ -261,7 +314,7 @@ int bench_perception(Context& ctx) {
 
 }  // namespace
 
-SG_BENCH("perception", "perception [--frames DIR] [--count N] [--json]",
+SG_BENCH("perception", "perception [--frames DIR|FILE|LIST.txt] [--count N] [--json]",
          "segmentation+floor+Manhattan+classification vs the paper's PCL pipeline", bench_perception);
 
 }  // namespace stairguide::cli
