@@ -312,6 +312,53 @@ void lower_region(SceneResult& scene, PlaneRegion& r, float drop) {
   r.height -= drop;
 }
 
+/// An ascending flight whose only floor in view lies beside it, `gap` (m) sideways from its side
+/// (a person or a wall end hides the floor in front of the first step).
+SceneBuilder flight_beside_floor(float gap, unsigned seed) {
+  SceneBuilder b(1.3f, 45.f, seed);
+  StairSpec s;
+  s.steps = 4;
+  s.width = 1.0f;
+  s.distance = 1.2f;
+  s.yaw_deg = 0.f;
+  b.add_stairs(s);
+  b.scene.regions.erase(b.scene.regions.begin() + b.scene.floor_region);
+  b.add_box_top(0.5f + gap + 0.5f, 1.5f, 1.0f, 2.0f, 0.f, RegionClass::kFloor);
+  b.scene.floor_region = static_cast<int>(b.scene.regions.size()) - 1;
+  return b;
+}
+
+TEST(StairsUnit, AFlightBesideTheFloorIsFoundByItsStack) {
+  StairStage stage(cfg());
+  StairResult r;
+  {
+    // 0.6 m sideways: beyond the connection radius, but the levels stand one and two risers above
+    // the floor with one riser between them.
+    SceneBuilder b = flight_beside_floor(0.6f, 21);
+    stage.run(b.scene, r);
+    ASSERT_TRUE(r.detected) << to_string(r.verdict);
+    EXPECT_EQ(r.kind, StairKind::kAscending);
+    EXPECT_EQ(r.level_data[1].index, 1);
+    EXPECT_NEAR(r.level_data[1].height, 0.17f, 0.01f);
+    EXPECT_LT(errors(r, b.truth).riser, 0.005f);
+  }
+  {
+    // The same stack raised by half a riser: its first level is no step above the floor.
+    SceneBuilder b = flight_beside_floor(0.6f, 22);
+    for (auto& reg : b.scene.regions)
+      if (reg.cls == RegionClass::kStepCandidate) lower_region(b.scene, reg, -0.085f);
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+  }
+  {
+    // 1.5 m sideways: too far from the floor to say it stands on it.
+    SceneBuilder b = flight_beside_floor(1.5f, 23);
+    stage.run(b.scene, r);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.verdict, StairVerdict::kNoFirstStep);
+  }
+}
+
 /// A descending flight straight ahead whose first edge lies `distance` in front of the camera's
 /// foot, the floor in front of it and the floor beside the stairwell (1.2 m on each side), seen by
 /// a 1.3 m high camera tilted 45 deg with a 45 deg vertical field of view: the view starts 0.54 m

@@ -16,6 +16,9 @@ constexpr int kMaxHiddenSteps = 3;
 // this of the lowest row any region reaches (about 10 px at a 525 px focal length; regions lose a
 // few rows at the border to the normal estimation).
 constexpr float kViewBottomSlack = 0.02f;
+// A first step found by its stack (build_stack) lies within this of the floor seen from above: a
+// person or a wall end (about half a metre) hides the foot of the flight, plus the usual radius.
+constexpr float kStackReach = 1.0f;
 }  // namespace
 
 StairDetection::StairDetection(const ClassificationConfig& classification, const StairDetectionConfig& config)
@@ -56,8 +59,8 @@ float StairDetection::view_bottom(const SceneResult& scene) const {
   return low;
 }
 
-bool StairDetection::connected(const Candidate& c, const LevelSeed& level, bool horizontal) const {
-  const float r = cfg_.connection_radius, r2 = r * r;
+bool StairDetection::connected(const Candidate& c, const LevelSeed& level, bool horizontal, float radius) const {
+  const float r = radius > 0.f ? radius : cfg_.connection_radius, r2 = r * r;
   const int need = std::max(1, (cfg_.connection_min_points + c.stride - 1) / c.stride);
   int found = 0;
   for (int region : level.regions) {
@@ -114,6 +117,7 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
   assigned_.assign(order_.size(), 0);
   sweep(hyp);
   if (hyp.step_levels() == 0 && direction < 0 && floor_tracked_ && !floor.regions.empty()) build_hidden(hyp);
+  if (hyp.step_levels() == 0 && direction > 0 && !floor.regions.empty()) build_stack(hyp);
 
   hyp.rejected = 0;
   for (char a : assigned_)
@@ -245,6 +249,52 @@ bool StairDetection::build_hidden(StairHypothesis& hyp) {
     hyp.levels.resize(1);
     assigned_.assign(order_.size(), 0);
     return false;
+  }
+  return false;
+}
+
+bool StairDetection::build_stack(StairHypothesis& hyp) {
+  // The connection rule (a first step must touch the floor) keeps a table top or a bench seat,
+  // floating above the floor, from being a first step. A level that does not touch the floor is
+  // still a first step when it lies one riser above the floor, beside the floor seen from above
+  // (a person or a wall hides where the flight meets the floor), and carries a flight: at least
+  // one more level, each a whole riser above the last, all with the same riser inside the building
+  // code. Furniture does not stack that way; shelves that happen to (boards one riser apart) stand
+  // straight above each other and have no tread, which modelling refuses.
+  const float hmin = cls_.step_height_min - cfg_.height_tolerance;
+  const float hmax = cls_.step_height_max + cfg_.height_tolerance;
+  const LevelSeed& floor = hyp.levels[0];
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    if (assigned_[i]) continue;
+    const Candidate& c = pool_[static_cast<std::size_t>(order_[i])];
+    const float s = std::fabs(c.height);
+    if (s < hmin) continue;
+    if (s > hmax) break;  // candidates are in height order: none higher can be the first step
+    if (static_cast<int>(c.sample.size()) * c.stride < kDoubtfulMinPoints) continue;
+    if (!connected(c, floor, true, kStackReach)) continue;
+    LevelSeed& l = hyp.levels.emplace_back();
+    l.index = 1;
+    l.height = c.height;
+    l.point_count = static_cast<int>(c.sample.size()) * c.stride;
+    l.regions.assign(1, c.region);
+    assigned_[i] = 1;
+    sweep(hyp);
+    const int n = hyp.step_levels();
+    bool ok = n >= 2;
+    if (ok) {
+      const float first = std::fabs(hyp.levels[1].height), last = std::fabs(hyp.levels.back().height);
+      const float riser = (last - first) / static_cast<float>(n - 1);
+      ok = riser >= hmin && riser <= hmax;
+      // Every level, the first included, a whole riser above the one below it (the floor at 0).
+      for (int k = 1; k <= n && ok; ++k)
+        ok = std::fabs(std::fabs(hyp.levels[static_cast<std::size_t>(k)].height) - static_cast<float>(k) * riser) <=
+             cfg_.same_level_tolerance;
+    }
+    if (ok) return true;
+    // Not a flight: undo and try the next candidate at step height (another piece of furniture
+    // may sit beside a real first step).
+    hyp.levels.resize(1);
+    std::fill(assigned_.begin(), assigned_.end(), 0);
   }
   return false;
 }

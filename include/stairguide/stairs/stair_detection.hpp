@@ -83,13 +83,18 @@ class StairDetection {
 
   void prepare(const SceneResult& scene, int region, Candidate& c) const;
   /// Points of `c` within the radius of the regions of `level`, >= the minimum (scaled by stride).
-  /// With `horizontal`, distances are taken in the horizontal plane (heights left out).
-  bool connected(const Candidate& c, const LevelSeed& level, bool horizontal = false) const;
+  /// With `horizontal`, distances are taken in the horizontal plane (heights left out). A positive
+  /// `radius` replaces the configured connection radius.
+  bool connected(const Candidate& c, const LevelSeed& level, bool horizontal = false, float radius = 0.f) const;
   void build(int direction, StairHypothesis& hyp);
   /// Algorithm 1's loop: adds unassigned candidates to the levels of `hyp` until nothing changes.
   void sweep(StairHypothesis& hyp);
   /// The hidden-first-steps route (see the file comment); true when it found a staircase.
   bool build_hidden(StairHypothesis& hyp);
+  /// Ascending, when no first step touches the floor: a stack of two or more evenly spaced levels
+  /// whose lowest lies one riser above the floor and beside it seen from above (the floor seen
+  /// only beside the stairs, the foot of the flight hidden); true when it found one.
+  bool build_stack(StairHypothesis& hyp);
   /// Lowest image row (as y/z) that any region of the scene reaches: the bottom of the view.
   float view_bottom(const SceneResult& scene) const;
 
