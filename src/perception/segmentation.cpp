@@ -9,6 +9,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <opencv2/imgproc.hpp>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace stairguide {
 
@@ -165,8 +168,9 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   w_.resize(n);
   un_.resize(static_cast<std::size_t>(W_));
   vn_.resize(static_cast<std::size_t>(H_));
-  label_.assign(n, -1);
-  tried_.assign(n, 0);
+  // label_ (-1) and tried_ (0) are initialised in the pass below, while each row is in cache.
+  label_.resize(n);
+  tried_.resize(n);
   queue_.resize(n);
   const float ifx = 1.f / K_.fx, ify = 1.f / K_.fy;
   for (int u = 0; u < W_; ++u) un_[u] = (static_cast<float>(u) - K_.cx) * ifx;
@@ -175,7 +179,30 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   for (int v = 0; v < H_; ++v) {
     const float* d = frame.depth.ptr<float>(v);
     const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(W_);
-    for (int u = 0; u < W_; ++u) {
+    std::fill(label_.begin() + static_cast<long>(row), label_.begin() + static_cast<long>(row + W_), -1);
+    std::memset(&tried_[row], 0, static_cast<std::size_t>(W_));
+    int u = 0;
+#if defined(__SSE2__)
+    {
+      // Four pixels at a time (the scalar loop does not vectorise: its division is conditional).
+      // 1/z of a valid reading is the same correctly rounded quotient as the scalar division.
+      const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), big = _mm_set1_ps(1e6f);
+      __m128i cnt = _mm_setzero_si128();
+      for (; u + 4 <= W_; u += 4) {
+        const __m128 dz = _mm_loadu_ps(d + u);
+        const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(dz, zero), _mm_cmplt_ps(dz, big));
+        const __m128 z = _mm_and_ps(ok, dz);
+        const __m128 safe = _mm_or_ps(z, _mm_andnot_ps(ok, one));
+        _mm_storeu_ps(&z_[row + u], z);
+        _mm_storeu_ps(&w_[row + u], _mm_and_ps(ok, _mm_div_ps(one, safe)));
+        cnt = _mm_sub_epi32(cnt, _mm_castps_si128(ok));
+      }
+      alignas(16) int c4[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(c4), cnt);
+      valid += c4[0] + c4[1] + c4[2] + c4[3];
+    }
+#endif
+    for (; u < W_; ++u) {
       float z = d[u];
       if (!(z > 0.f && z < 1e6f)) z = 0.f;  // no reading, NaN or infinite
       z_[row + u] = z;
@@ -445,20 +472,104 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
       full[3] += gu[i] * gv[j];
       full[4] += gv[j] * gv[j];
     }
+  // Float sums centred on the cell (exact enough for a few dozen pixels, and twice as fast),
+  // shifted to the global double moments afterwards. The reference value w0 is the cell's first
+  // valid reading (0: the cell has none).
+  auto first_w = [&](int cu, int cv) {
+    const int u0 = cu * cs, v0 = cv * cs;
+    for (int v = v0; v < v0 + cs; ++v)
+      for (int u = u0; u < u0 + cs; ++u)
+        if (w_[static_cast<std::size_t>(v) * W_ + u] > 0.f) return w_[static_cast<std::size_t>(v) * W_ + u];
+    return 0.f;
+  };
+  // The rest of a cell once its sums with w are known (n: count of valid pixels).
+  auto finish = [&](int cu, int cv, float w0, float n, float Sw, float Suw, float Svw, float Sww) {
+    if (n < need) return;
+    InvDepthMoments& m = cell_m_[static_cast<std::size_t>(cv * CW_ + cu)];
+    const int u0 = cu * cs, v0 = cv * cs;
+    const float uc = un_[u0], vc = vn_[v0];
+    // The pixel-coordinate sums: those of a full cell (most cells), else summed over the valid.
+    float Su = full[0], Sv = full[1], Suu = full[2], Suv = full[3], Svv = full[4];
+    if (n < static_cast<float>(cs * cs)) {
+      Su = Sv = Suu = Suv = Svv = 0.f;
+      for (int v = v0; v < v0 + cs; ++v) {
+        const float dv = gv[v - v0];
+        const float* w = &w_[static_cast<std::size_t>(v) * W_ + u0];
+        for (int i = 0; i < cs; ++i) {
+          const float ok = w[i] > 0.f ? 1.f : 0.f;
+          const float du = gu[i] * ok, dvv = dv * ok;
+          Su += du; Sv += dvv;
+          Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
+        }
+      }
+    }
+    const double U = uc, V = vc, Wc = w0;
+    m.n = n;
+    m.su = Su + n * U;
+    m.sv = Sv + n * V;
+    m.sw = Sw + n * Wc;
+    m.suu = Suu + 2 * U * Su + n * U * U;
+    m.suv = Suv + U * Sv + V * Su + n * U * V;
+    m.svv = Svv + 2 * V * Sv + n * V * V;
+    m.suw = Suw + U * Sw + Wc * Su + n * U * Wc;
+    m.svw = Svw + V * Sw + Wc * Sv + n * V * Wc;
+    m.sww = Sww + 2 * Wc * Sw + n * Wc * Wc;
+    const PlaneFit f = fit_plane(m);
+    // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
+    if (!f.ok || f.rms_w > limit) return;
+    cell_planar_[static_cast<std::size_t>(cv * CW_ + cu)] = 1;
+    // Nearer cells first: their planes are the most precise seeds.
+    cells_.push_back({cu, cv, f.rms_w / limit + f.mean.z()});
+  };
   for (int cv = 0; cv < CH_; ++cv) {
-    for (int cu = 0; cu < CW_; ++cu) {
-      InvDepthMoments& m = cell_m_[static_cast<std::size_t>(cv * CW_ + cu)];
-      // Float sums centred on the cell (exact enough for a few dozen pixels, and twice as fast),
-      // shifted to the global double moments afterwards.
-      const int u0 = cu * cs, v0 = cv * cs;
-      const float uc = un_[u0], vc = vn_[v0];
-      float w0 = 0.f;
-      for (int v = v0; v < v0 + cs && w0 == 0.f; ++v)
-        for (int u = u0; u < u0 + cs; ++u)
-          if (w_[static_cast<std::size_t>(v) * W_ + u] > 0.f) {
-            w0 = w_[static_cast<std::size_t>(v) * W_ + u];
-            break;
+    const int v0 = cv * cs;
+    int cu = 0;
+#if defined(__SSE2__)
+    // Four horizontally adjacent cells at once, one per SIMD lane: each lane adds its cell's
+    // pixels in the same order as the scalar loop below, so the sums are bit-identical.
+    if (cs % 4 == 0) {
+      const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
+      for (; cu + 4 <= CW_; cu += 4) {
+        alignas(16) float w0s[4];
+        for (int k = 0; k < 4; ++k) w0s[k] = first_w(cu + k, cv);
+        if (w0s[0] == 0.f && w0s[1] == 0.f && w0s[2] == 0.f && w0s[3] == 0.f) continue;
+        const __m128 w0 = _mm_load_ps(w0s);
+        __m128 n = zero, Sw = zero, Suw = zero, Svw = zero, Sww = zero;
+        for (int v = v0; v < v0 + cs; ++v) {
+          const __m128 dv = _mm_set1_ps(gv[v - v0]);
+          const float* base = &w_[static_cast<std::size_t>(v) * W_ + static_cast<std::size_t>(cu * cs)];
+          for (int i = 0; i < cs; i += 4) {
+            __m128 r0 = _mm_loadu_ps(base + i), r1 = _mm_loadu_ps(base + cs + i);
+            __m128 r2 = _mm_loadu_ps(base + 2 * cs + i), r3 = _mm_loadu_ps(base + 3 * cs + i);
+            _MM_TRANSPOSE4_PS(r0, r1, r2, r3);  // r<j>: pixel i + j of the four cells
+            const __m128 px[4] = {r0, r1, r2, r3};
+            for (int j = 0; j < 4; ++j) {
+              const __m128 w = px[j];
+              const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(w, zero), one);
+              const __m128 dw = _mm_mul_ps(_mm_sub_ps(w, w0), ok);
+              const __m128 g = _mm_set1_ps(gu[i + j]);
+              n = _mm_add_ps(n, ok);
+              Sw = _mm_add_ps(Sw, dw);
+              Suw = _mm_add_ps(Suw, _mm_mul_ps(g, dw));
+              Svw = _mm_add_ps(Svw, _mm_mul_ps(dv, dw));
+              Sww = _mm_add_ps(Sww, _mm_mul_ps(dw, dw));
+            }
           }
+        }
+        alignas(16) float an[4], asw[4], asuw[4], asvw[4], asww[4];
+        _mm_store_ps(an, n);
+        _mm_store_ps(asw, Sw);
+        _mm_store_ps(asuw, Suw);
+        _mm_store_ps(asvw, Svw);
+        _mm_store_ps(asww, Sww);
+        for (int k = 0; k < 4; ++k)
+          if (w0s[k] != 0.f) finish(cu + k, cv, w0s[k], an[k], asw[k], asuw[k], asvw[k], asww[k]);
+      }
+    }
+#endif
+    for (; cu < CW_; ++cu) {
+      const int u0 = cu * cs;
+      const float w0 = first_w(cu, cv);
       if (w0 == 0.f) continue;
       // Sums with w first: an invalid pixel has dw = 0, so only the count needs the mask there.
       float n = 0, Sw = 0, Suw = 0, Svw = 0, Sww = 0;
@@ -475,39 +586,7 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
           Sww += dw * dw;
         }
       }
-      if (n < need) continue;
-      // The pixel-coordinate sums: those of a full cell (most cells), else summed over the valid.
-      float Su = full[0], Sv = full[1], Suu = full[2], Suv = full[3], Svv = full[4];
-      if (n < static_cast<float>(cs * cs)) {
-        Su = Sv = Suu = Suv = Svv = 0.f;
-        for (int v = v0; v < v0 + cs; ++v) {
-          const float dv = gv[v - v0];
-          const float* w = &w_[static_cast<std::size_t>(v) * W_ + u0];
-          for (int i = 0; i < cs; ++i) {
-            const float ok = w[i] > 0.f ? 1.f : 0.f;
-            const float du = gu[i] * ok, dvv = dv * ok;
-            Su += du; Sv += dvv;
-            Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
-          }
-        }
-      }
-      const double U = uc, V = vc, Wc = w0;
-      m.n = n;
-      m.su = Su + n * U;
-      m.sv = Sv + n * V;
-      m.sw = Sw + n * Wc;
-      m.suu = Suu + 2 * U * Su + n * U * U;
-      m.suv = Suv + U * Sv + V * Su + n * U * V;
-      m.svv = Svv + 2 * V * Sv + n * V * V;
-      m.suw = Suw + U * Sw + Wc * Su + n * U * Wc;
-      m.svw = Svw + V * Sw + Wc * Sv + n * V * Wc;
-      m.sww = Sww + 2 * Wc * Sw + n * Wc * Wc;
-      const PlaneFit f = fit_plane(m);
-      // Planar when the residual is within the depth noise (constant in 1/z for a Kinect).
-      if (!f.ok || f.rms_w > limit) continue;
-      cell_planar_[static_cast<std::size_t>(cv * CW_ + cu)] = 1;
-      // Nearer cells first: their planes are the most precise seeds.
-      cells_.push_back({cu, cv, f.rms_w / limit + f.mean.z()});
+      finish(cu, cv, w0, n, Sw, Suw, Svw, Sww);
     }
   }
   stats_.planar_cells = static_cast<int>(cells_.size());
@@ -567,8 +646,8 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
     for (int v = cv * cs; v < (cv + 1) * cs; ++v) {
       int* l = &label_[static_cast<std::size_t>(v) * W_];
       const float* w = &w_[static_cast<std::size_t>(v) * W_];
-      for (int u = cu * cs; u < (cu + 1) * cs; ++u)
-        if (w[u] > 0.f) l[u] = r;
+      // Branch-free (vectorised): these pixels are all still -1.
+      for (int u = cu * cs; u < (cu + 1) * cs; ++u) l[u] = w[u] > 0.f ? r : -1;
     }
   }
   // Pixel-level refinement of the other cells next to regions (edges between planes, holes,
@@ -589,20 +668,27 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
         if (!dup) cand[nk++] = r;
       }
     if (nk == 0) continue;
+    // The candidates' plane coefficients in registers (the moments below are updated per pixel).
+    float pa[8], pb[8], pc[8];
+    for (int i = 0; i < nk; ++i) {
+      const PlaneFit& f = grows[cand[i]].plane;
+      pa[i] = f.a, pb[i] = f.b, pc[i] = f.c;
+    }
     for (int v = cv * cs; v < (cv + 1) * cs; ++v) {
       const float vv = vn_[v];
+      const float* wr = &w_[static_cast<std::size_t>(v) * W_];
       for (int u = cu * cs; u < (cu + 1) * cs; ++u) {
-        const int p = v * W_ + u;
-        const float w = w_[p];
+        const float w = wr[u];
         if (w <= 0.f) continue;
+        const float uu = un_[u];
         int best = -1;
         float bres = tw;
         for (int i = 0; i < nk; ++i) {
-          const PlaneFit& f = grows[cand[i]].plane;
-          const float res = std::fabs(w - (f.a * un_[u] + f.b * vv + f.c));
+          const float res = std::fabs(w - (pa[i] * uu + pb[i] * vv + pc[i]));
           if (res <= bres) bres = res, best = cand[i];
         }
         if (best < 0) continue;
+        const int p = v * W_ + u;
         label_[p] = best;
         grows[best].m.add(un_[u], vv, w);
         ++grows[best].count;
@@ -650,25 +736,34 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
   };
   // Regions touching directly or across a one-pixel gap of unassigned (noisy) pixels. Every
   // other row and column is enough to see two regions that share a border.
+  // Inside a region cell every valid pixel carries the cell's label: a pixel whose right and
+  // lower neighbours (and the ones beyond them) are still in the cell marks nothing, and is skipped.
+  const int cs = std::max(2, cfg_.cell_size_px);
   for (int v = 0; v < H_; v += 2) {
-    for (int u = 0; u < W_; ++u) {
-      const int p = v * W_ + u;
-      const int a = label_[p];
-      if (a < 0) continue;
-      if (u + 1 < W_) {
-        const int b = label_[p + 1];
-        if (b >= 0) {
-          if (b != a) mark(p, p + 1);
-        } else if (u + 2 < W_) {
-          mark(p, p + 2);
+    const int cv = vcell_[v];
+    const bool inner_row = cv < CH_ && v + 2 < (cv + 1) * cs;
+    for (int u = 0, cu = 0; u < W_; ++cu) {
+      const int ue = cu < CW_ ? u + cs : W_;
+      if (inner_row && cu < CW_ && cell_label_[static_cast<std::size_t>(cv * CW_ + cu)] >= 0) u += cs - 2;
+      for (; u < ue; ++u) {
+        const int p = v * W_ + u;
+        const int a = label_[p];
+        if (a < 0) continue;
+        if (u + 1 < W_) {
+          const int b = label_[p + 1];
+          if (b >= 0) {
+            if (b != a) mark(p, p + 1);
+          } else if (u + 2 < W_) {
+            mark(p, p + 2);
+          }
         }
-      }
-      if ((u & 1) == 0 && v + 1 < H_) {
-        const int b = label_[p + W_];
-        if (b >= 0) {
-          if (b != a) mark(p, p + W_);
-        } else if (v + 2 < H_) {
-          mark(p, p + 2 * W_);
+        if ((u & 1) == 0 && v + 1 < H_) {
+          const int b = label_[p + W_];
+          if (b >= 0) {
+            if (b != a) mark(p, p + W_);
+          } else if (v + 2 < H_) {
+            mark(p, p + 2 * W_);
+          }
         }
       }
     }
@@ -717,7 +812,6 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
   for (int r = 0; r < n; ++r) parent[r] = find_root(parent, r);
   // Relabel. The valid pixels of a region cell all carry the cell's label (the passes after the
   // cell pass take only free pixels): a cell of an unmerged region is skipped whole.
-  const int cs = std::max(2, cfg_.cell_size_px);
   for (int v = 0; v < H_; ++v) {
     int* lab = &label_[static_cast<std::size_t>(v) * W_];
     const int cv = vcell_[v];
@@ -847,7 +941,11 @@ void Segmentation::refine_borders(std::vector<Grow>& grows) {
   // Edges between planes run through the cells that were not planar (whole planar cells went to
   // one region), and through the image margin outside the cell grid.
   const int cs = std::max(2, cfg_.cell_size_px);
+  const int* L = label_.data();
+  int* buf = queue_.data();  // free here (holds W x H entries)
+  int nb = 0;
   for (int v = 0, cv = 0, vr = 0; v < H_; ++v) {
+    const bool vin = v > 0 && v + 1 < H_;
     // (cv, cu): the pixel's cell, stepped along without divisions (this scans every pixel).
     for (int u = 0, cu = 0; u < W_; cu++) {
       if (cv < CH_ && cu < CW_ && cell_label_[cv * CW_ + cu] >= 0) {
@@ -857,17 +955,27 @@ void Segmentation::refine_borders(std::vector<Grow>& grows) {
       const int ue = cu < CW_ ? u + cs : W_;
       for (; u < ue; ++u) {
         const int p = v * W_ + u;
-        const int a = label_[p];
-        if (a < 0) continue;
-        if ((u + 1 < W_ && label_[p + 1] >= 0 && label_[p + 1] != a) ||
-            (u > 0 && label_[p - 1] >= 0 && label_[p - 1] != a) ||
-            (v + 1 < H_ && label_[p + W_] >= 0 && label_[p + W_] != a) ||
-            (v > 0 && label_[p - W_] >= 0 && label_[p - W_] != a))
-          cur.push_back(p);
+        const int a = L[p];
+        bool border;
+        if (vin && u > 0 && u + 1 < W_) {
+          // Branch-free inside the image (these tests mispredict often on real frames); the
+          // pixels are written in raster order either way.
+          const int r = L[p + 1], l = L[p - 1], d = L[p + W_], t = L[p - W_];
+          border = (a >= 0) & (((r >= 0) & (r != a)) | ((l >= 0) & (l != a)) | ((d >= 0) & (d != a)) |
+                               ((t >= 0) & (t != a)));
+        } else {
+          border = a >= 0 && ((u + 1 < W_ && L[p + 1] >= 0 && L[p + 1] != a) ||
+                              (u > 0 && L[p - 1] >= 0 && L[p - 1] != a) ||
+                              (v + 1 < H_ && L[p + W_] >= 0 && L[p + W_] != a) ||
+                              (v > 0 && L[p - W_] >= 0 && L[p - W_] != a));
+        }
+        buf[nb] = p;
+        nb += border;
       }
     }
     if (++vr == cs) vr = 0, ++cv;
   }
+  cur.assign(buf, buf + nb);
   const float kl = 1.41421356f * tolerance_w();
   for (int iter = 0; iter < 8 && !cur.empty(); ++iter) {
     nxt.clear();
@@ -932,15 +1040,41 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
     fits_[out] = f;
     map[r] = static_cast<int>(out++);
   }
-  if (regions.size() < out) regions.resize(out);
+  // The pixel and point buffers of the last frame's regions are pooled and handed out again,
+  // biggest to the biggest region: a region's size changes from frame to frame, and growing
+  // buffers of 10^5 entries anew each frame cost more than the raster pass filling them.
+  for (PlaneRegion& R : regions) {
+    pixel_pool_.push_back(std::move(R.pixels));
+    point_pool_.push_back(std::move(R.points));
+  }
   regions.resize(out);
   acc_.assign(out, RegionAcc{});
-  for (std::size_t i = 0; i < out; ++i) {
-    regions[i].pixels.clear();
-    regions[i].points.clear();
-  }
+  std::sort(pixel_pool_.begin(), pixel_pool_.end(),
+            [](const std::vector<int>& a, const std::vector<int>& b) { return a.capacity() < b.capacity(); });
+  std::sort(point_pool_.begin(), point_pool_.end(),
+            [](const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::Vector3f>& b) {
+              return a.capacity() < b.capacity();
+            });
+  std::vector<int>& by_size = live_;  // surviving grown regions, biggest first
+  by_size.clear();
   for (int r = 0; r < n; ++r)
-    if (map[r] >= 0) regions[map[r]].pixels.reserve(static_cast<std::size_t>(grows[r].count));
+    if (map[r] >= 0) by_size.push_back(r);
+  std::sort(by_size.begin(), by_size.end(), [&](int a, int b) { return grows[a].count > grows[b].count; });
+  for (int r : by_size) {
+    PlaneRegion& R = regions[map[r]];
+    if (!pixel_pool_.empty()) {
+      R.pixels = std::move(pixel_pool_.back());
+      pixel_pool_.pop_back();
+    }
+    if (!point_pool_.empty()) {
+      R.points = std::move(point_pool_.back());
+      point_pool_.pop_back();
+    }
+    R.pixels.clear();
+    R.points.clear();
+    const std::size_t cnt = static_cast<std::size_t>(grows[r].count);
+    if (R.pixels.capacity() < cnt) R.pixels.reserve(cnt + cnt / 2);
+  }
   // One raster pass: pixels, points, centroid, footprint area, moments for the principal axes.
   const int stride = std::max(1, cfg_.points_stride_px);
   // Labels come in long horizontal runs (a tread spans hundreds of pixels of a row): handle each
@@ -1058,6 +1192,13 @@ void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
   cv::Mat m(H_, W_, CV_8UC1, mask_.data());
   cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), 1);
   const int stride = std::max(1, cfg_.points_stride_px);
+  // Point buffers of the last frame's clusters are pooled (smallest first) and reused, the
+  // smallest that fits each new cluster: no allocation per frame once they have grown.
+  for (ObstacleCluster& c : clusters) cluster_pool_.push_back(std::move(c.points));
+  std::sort(cluster_pool_.begin(), cluster_pool_.end(),
+            [](const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::Vector3f>& b) {
+              return a.capacity() < b.capacity();
+            });
   std::size_t out = 0;
   for (int s = 0; s < N; ++s) {
     // Next unvisited obstacle pixel (memchr scans in vector steps).
@@ -1089,7 +1230,18 @@ void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
     if (tail < cfg_.cluster_min_pixels) continue;
     if (out >= clusters.size()) clusters.emplace_back();
     ObstacleCluster& c = clusters[out++];
-    c.points.clear();
+    {
+      // Points kept: every stride-th pixel both ways, about tail / stride^2 (a bound suffices).
+      const std::size_t need = static_cast<std::size_t>(tail) / static_cast<std::size_t>(stride * stride) + 64;
+      auto it = std::lower_bound(cluster_pool_.begin(), cluster_pool_.end(), need,
+                                 [](const std::vector<Eigen::Vector3f>& a, std::size_t k) { return a.capacity() < k; });
+      if (it == cluster_pool_.end() && !cluster_pool_.empty()) --it;
+      if (it != cluster_pool_.end()) {
+        c.points = std::move(*it);
+        cluster_pool_.erase(it);
+      }
+      c.points.clear();
+    }
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Vector3f mn = Eigen::Vector3f::Constant(1e9f), mx = Eigen::Vector3f::Constant(-1e9f);
     for (int i = 0; i < tail; ++i) {

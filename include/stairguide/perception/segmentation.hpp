@@ -188,6 +188,9 @@ class Segmentation {
   };
   std::vector<RegionAcc> acc_;
   std::vector<PlaneFit> fits_;
+  std::vector<std::vector<int>> pixel_pool_;               // finalize: buffers of regions not in use
+  std::vector<std::vector<Eigen::Vector3f>> point_pool_;
+  std::vector<std::vector<Eigen::Vector3f>> cluster_pool_;  // extract_clusters: point buffers not in use
   int CW_ = 0, CH_ = 0;                  // cell grid
   std::vector<InvDepthMoments> cell_m_;
   std::vector<int> cell_label_;
