@@ -307,20 +307,8 @@ void FloorlessStairs::riser_positions(const SceneResult& scene, const StairResul
 
 void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, StairResult& out) {
   trace_ = FloorlessTrace{};
-  out.detected = false;
-  out.verdict = StairVerdict::kNoFloor;
-  out.kind = StairKind::kNone;
-  out.levels = 0;
-  out.riser_m = out.tread_m = out.width_m = 0.f;
-  out.width_complete = false;
-  out.T_camera_stair = Pose::Identity();
-  out.edge_left.setZero();
-  out.edge_right.setZero();
-  out.method = StairAxesMethod::kNone;
+  out.clear(StairVerdict::kNoFloor, 0);
   out.without_floor = true;
-  out.floor_remembered = false;
-  out.level_data.clear();
-  out.candidates = out.rejected_candidates = 0;
   if (!find_up(scene)) return;
   build_nodes(scene);
   const std::size_t m = order_.size();

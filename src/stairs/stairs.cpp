@@ -40,23 +40,7 @@ StairStage::StairStage(const ClassificationConfig& classification, const StairDe
 
 namespace {
 
-void reset(StairResult& r, StairVerdict v, int candidates) {
-  r.detected = false;
-  r.verdict = v;
-  r.kind = StairKind::kNone;
-  r.levels = 0;
-  r.riser_m = r.tread_m = r.width_m = 0.f;
-  r.width_complete = false;
-  r.T_camera_stair = Pose::Identity();
-  r.edge_left.setZero();
-  r.edge_right.setZero();
-  r.method = StairAxesMethod::kNone;
-  r.without_floor = false;
-  r.floor_remembered = false;
-  r.level_data.clear();
-  r.candidates = candidates;
-  r.rejected_candidates = candidates;
-}
+void reset(StairResult& r, StairVerdict v, int candidates) { r.clear(v, candidates); }
 
 /// True when `a` is the better answer for the user than `b`.
 bool better(const StairResult& a, const StairResult& b) {

@@ -104,6 +104,25 @@ struct StairResult {
 
   /// Centre of the first edge in the camera frame.
   Eigen::Vector3f origin() const { return T_camera_stair.translation(); }
+
+  /// Nothing found, for `why`: every field back to its default except the timings (level_data
+  /// keeps its capacity), with `candidates` counted and all of them left out.
+  void clear(StairVerdict why, int candidates_considered) {
+    detected = false;
+    verdict = why;
+    kind = StairKind::kNone;
+    levels = 0;
+    riser_m = tread_m = width_m = 0.f;
+    width_complete = false;
+    T_camera_stair = Pose::Identity();
+    edge_left.setZero();
+    edge_right.setZero();
+    method = StairAxesMethod::kNone;
+    without_floor = false;
+    floor_remembered = false;
+    level_data.clear();
+    candidates = rejected_candidates = candidates_considered;
+  }
 };
 
 }  // namespace stairguide
