@@ -6,22 +6,17 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <random>
 
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
+#include "capture_test_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace stairguide;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  fs::path p = fs::path(STAIRGUIDE_BINARY_DIR) / "test_scratch" / "capture_dataset" / name;
-  fs::remove_all(p);
-  fs::create_directories(p.parent_path());
-  return p;
-}
+fs::path scratch(const std::string& name) { return test::scratch("capture_dataset", name); }
 
 Pose make_pose(float yaw, float pitch, float x, float y, float z) {
   Pose p = Pose::Identity();
@@ -32,25 +27,8 @@ Pose make_pose(float yaw, float pitch, float x, float y, float z) {
   return p;
 }
 
-// Frames made here (the synthetic renderer is tested on its own): depth already on the 1 mm grid
-// so that the 16-bit PNG keeps it exactly, with holes; colour random.
 std::vector<RgbdFrame> make_frames(int n, int w, int h, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> mm(400, 6000);
-  std::vector<RgbdFrame> out;
-  for (int i = 0; i < n; ++i) {
-    RgbdFrame f;
-    f.index = static_cast<std::uint64_t>(i);
-    f.timestamp = 12.5 + i / 30.0;
-    f.intrinsics = CameraIntrinsics{}.scaled(static_cast<float>(w) / 640.f);
-    f.depth.create(h, w, CV_32FC1);
-    for (int r = 0; r < h; ++r)
-      for (int c = 0; c < w; ++c) f.depth.at<float>(r, c) = ((r + c + i) % 7 == 0) ? 0.f : mm(rng) / 1000.f;
-    f.color.create(h, w, CV_8UC3);
-    cv::randu(f.color, 0, 256);
-    out.push_back(f);
-  }
-  return out;
+  return test::make_frames(n, w, h, seed, 6000, 12.5);
 }
 
 FrameTruth make_truth(int i) {
@@ -133,15 +111,7 @@ void write_text(const fs::path& p, const std::string& s) {
   o << s;
 }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SourceError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 bool shared_data(fs::path& root) {
   root = STAIRGUIDE_SHARED_DATA;

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "capture_test_util.hpp"
 #include "stairguide/capture/device.hpp"
 
 using namespace stairguide;
@@ -22,15 +23,7 @@ bool camera_attached() {
   return false;
 }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SourceError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 }  // namespace
 

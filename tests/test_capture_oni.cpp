@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 
+#include "capture_test_util.hpp"
 #include "stairguide/capture/oni.hpp"
 
 namespace fs = std::filesystem;
@@ -14,33 +15,10 @@ using namespace stairguide;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(STAIRGUIDE_BINARY_DIR) / "test_scratch" / "capture_oni";
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
-  fs::remove_all(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return test::scratch("capture_oni", name); }
 
-// Depth on the 1 mm grid (what the recording stores) with holes; colour random.
 std::vector<RgbdFrame> make_frames(int n, int w, int h, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> mm(400, 9000);
-  std::vector<RgbdFrame> out;
-  for (int i = 0; i < n; ++i) {
-    RgbdFrame f;
-    f.index = static_cast<std::uint64_t>(i);
-    f.timestamp = 100.0 + i / 30.0;
-    f.intrinsics = CameraIntrinsics{}.scaled(static_cast<float>(w) / 640.f);
-    f.depth.create(h, w, CV_32FC1);
-    for (int r = 0; r < h; ++r)
-      for (int c = 0; c < w; ++c)
-        f.depth.at<float>(r, c) = ((r * 3 + c + i) % 11 == 0) ? 0.f : mm(rng) / 1000.f;
-    f.color.create(h, w, CV_8UC3);
-    cv::randu(f.color, 0, 256);
-    out.push_back(f);
-  }
-  return out;
+  return test::make_frames(n, w, h, seed, 9000, 100.0);
 }
 
 void write_oni(const fs::path& p, const std::vector<RgbdFrame>& frames, bool color = true) {
@@ -50,15 +28,7 @@ void write_oni(const fs::path& p, const std::vector<RgbdFrame>& frames, bool col
   EXPECT_EQ(w.frames_written(), static_cast<long>(frames.size()));
 }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SourceError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 }  // namespace
 
