@@ -46,21 +46,11 @@ float disparity_noise_sigma(float z, const SynthOptions& o) {
   return var > 0.f ? std::sqrt(var) : 0.f;
 }
 
-void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& o,
-                        std::uint64_t seed, cv::Mat& depth_out) {
+void depth_sensor_holes(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& o,
+                        std::vector<unsigned char>& hole) {
   const int W = ideal.depth.cols, H = ideal.depth.rows;
-  depth_out.create(H, W, CV_32FC1);
-  const float zmin = o.min_range_m, zmax = o.max_range_m;
-  if (!o.noise) {
-    for (int v = 0; v < H; ++v) {
-      const float* in = ideal.depth.ptr<float>(v);
-      float* out = depth_out.ptr<float>(v);
-      for (int u = 0; u < W; ++u) out[u] = (in[u] >= zmin && in[u] <= zmax) ? in[u] : 0.f;
-    }
-    return;
-  }
-
-  std::vector<unsigned char> hole(static_cast<std::size_t>(W * H), 0);
+  hole.assign(static_cast<std::size_t>(W * H), 0);
+  if (!o.noise) return;
   const float cos_graze = std::cos(deg2rad(o.grazing_max_deg));
   const float shadow_f = K.fx * o.baseline_m;  // shadows use the image's own projection
   for (int v = 0; v < H; ++v) {
@@ -95,6 +85,24 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
       }
     }
   }
+}
+
+void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& o,
+                        std::uint64_t seed, cv::Mat& depth_out) {
+  const int W = ideal.depth.cols, H = ideal.depth.rows;
+  depth_out.create(H, W, CV_32FC1);
+  const float zmin = o.min_range_m, zmax = o.max_range_m;
+  if (!o.noise) {
+    for (int v = 0; v < H; ++v) {
+      const float* in = ideal.depth.ptr<float>(v);
+      float* out = depth_out.ptr<float>(v);
+      for (int u = 0; u < W; ++u) out[u] = (in[u] >= zmin && in[u] <= zmax) ? in[u] : 0.f;
+    }
+    return;
+  }
+
+  std::vector<unsigned char> hole;
+  depth_sensor_holes(ideal, K, o, hole);
 
   const float F = o.disparity_focal_px * o.baseline_m;
   const float q = o.disparity_step_px, inv_q = 1.f / q;

@@ -58,23 +58,21 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
   // A tread pixel counts as visible only where the depth sensor gives a reading: a far tread
   // seen beyond the grazing-incidence limit, or a strip lost to mixed pixels behind a nosing,
   // shows in the ideal render but not to a depth camera. The sensor model's own hole rules
-  // decide (range, grazing incidence, depth jumps, projector shadows); its random dropout is
-  // left out (no seed here, and a 0.2 % dropout does not hide a tread).
-  SynthOptions sensed_o = o;
-  sensed_o.dropout = 0.f;
-  cv::Mat sensed;
-  apply_depth_sensor(ideal, K, sensed_o, 1u, sensed);
+  // decide (grazing incidence, depth jumps, projector shadows; the range is checked below); its
+  // random dropout and noise are left out (a 0.2 % dropout does not hide a tread).
+  std::vector<unsigned char> hole;
+  depth_sensor_holes(ideal, K, o, hole);
   std::vector<int> counts(static_cast<std::size_t>(slot_base.back()), 0);
   long floor_pixels = 0;
   for (int v = 0; v < ideal.face.rows; ++v) {
     const int* fr = ideal.face.ptr<int>(v);
     const float* zr = ideal.depth.ptr<float>(v);
-    const float* sr = sensed.ptr<float>(v);
+    const unsigned char* hr = &hole[static_cast<std::size_t>(v) * static_cast<std::size_t>(ideal.face.cols)];
     for (int u = 0; u < ideal.face.cols; ++u) {
       const int f = fr[u];
       if (f < 0 || zr[u] < o.min_range_m || zr[u] > o.max_range_m) continue;
       const int slot = face_slot[static_cast<std::size_t>(f)];
-      if (slot >= 0 && sr[u] > 0.f) ++counts[static_cast<std::size_t>(slot)];
+      if (slot >= 0 && !hr[u]) ++counts[static_cast<std::size_t>(slot)];
       floor_pixels += face_floor[static_cast<std::size_t>(f)];
     }
   }

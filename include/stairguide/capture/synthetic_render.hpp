@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "stairguide/capture/synthetic_scene.hpp"
 #include "stairguide/core/types.hpp"
@@ -29,6 +30,12 @@ struct RenderBuffers {
 /// Deterministic; prints nothing. `shade` = false skips colour (depth, face and incidence only).
 void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsics& K, RenderBuffers& out,
             bool shade = true);
+
+/// The pixels the depth sensor loses whatever the noise draws (grazing incidence, the far side of
+/// depth discontinuities, projector shadows): `hole` (W*H, row-major) is 1 there. None when
+/// `options.noise` is false. Range limits and random dropout are not part of it.
+void depth_sensor_holes(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& options,
+                        std::vector<unsigned char>& hole);
 
 /// Kinect-like depth from the ideal render: holes (outside [min, max] range, grazing incidence,
 /// depth discontinuities, projector shadows, random dropouts), disparity noise and quantisation,
