@@ -242,18 +242,6 @@ TEST(DenseOdometry, FlagsJumpBeyondWalkingMotion) {
   EXPECT_LE(r.T_prev_curr.translation().norm(), 1e-6f);  // held the (zero) velocity guess
 }
 
-TEST(DenseOdometry, TwoThreadsGiveTheSameEstimate) {
-  const Pair p = make_pair(motion(0.02f, 0.01f, 0.03f, 0.5f, -1.0f, 0.3f), true, 3);
-  OdometryConfig one, two;
-  two.threads = 2;
-  const OdometryResult r1 = track_pair(p, one), r2 = track_pair(p, two);
-  ASSERT_TRUE(r1.ok && r2.ok);
-  const Err e = pose_error(r1.T_prev_curr, r2.T_prev_curr);
-  EXPECT_LE(e.t, 2e-5f);
-  EXPECT_LE(e.r, 1e-3f);
-  EXPECT_NEAR(r1.pixels_used, r2.pixels_used, 2);
-}
-
 TEST(DenseOdometry, AllocatesNothingPerFrameAfterTheFirst) {
   const sgtest::Scene scene = sgtest::Scene::stairs();
   const Pose T0 = sgtest::chest_camera(0.f, 0.f, 1.35f, 45.f);
@@ -274,20 +262,16 @@ TEST(DenseOdometry, AllocatesNothingPerFrameAfterTheFirst) {
   // stage's own work.
   const int cv_threads = cv::getNumThreads();
   cv::setNumThreads(0);
-  for (int threads : {1, 2}) {
-    OdometryConfig cfg;
-    cfg.threads = threads;
-    DenseOdometry odo(cfg, vga());
-    ASSERT_TRUE(odo.track(frames[0]).ok);
-    ASSERT_TRUE(odo.track(frames[1]).ok);
-    const long before = g_allocations.load();
-    bool all_ok = true;
-    for (int i = 2; i < 5; ++i) all_ok = odo.track(frames[static_cast<std::size_t>(i)]).ok && all_ok;
-    const long after = g_allocations.load();
-    EXPECT_TRUE(all_ok);
-    EXPECT_EQ(after - before, 0) << threads << " thread(s)";
-  }
+  DenseOdometry odo(OdometryConfig{}, vga());
+  ASSERT_TRUE(odo.track(frames[0]).ok);
+  ASSERT_TRUE(odo.track(frames[1]).ok);
+  const long before = g_allocations.load();
+  bool all_ok = true;
+  for (int i = 2; i < 5; ++i) all_ok = odo.track(frames[static_cast<std::size_t>(i)]).ok && all_ok;
+  const long after = g_allocations.load();
   cv::setNumThreads(cv_threads);
+  EXPECT_TRUE(all_ok);
+  EXPECT_EQ(after - before, 0);
 }
 
 TEST(DenseOdometry, RejectsFrameOfAnotherSize) {

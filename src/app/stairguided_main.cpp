@@ -7,6 +7,8 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -125,6 +127,10 @@ int main(int argc, char** argv) {
       return 3;
     }
   }
+
+  // OpenCV's own worker pool (cvtColor, convertTo in capture) would run beside the daemon's
+  // capture, odometry and perception threads on a 2-core unit; each call runs on its caller.
+  cv::setNumThreads(1);
 
   runtime::setup_logging("info");
   PipelineConfig config;

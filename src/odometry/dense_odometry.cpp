@@ -10,8 +10,8 @@
 //  - An iteration walks the list in blocks of kBlock points: a scalar pass warps and samples B
 //    (gathers do not vectorise), then the 6x6 normal equations are summed over the block with
 //    8 independent lanes, which the compiler turns into SIMD without -ffast-math.
-//  - With threads == 2, each level's point list is split in two halves built and accumulated by
-//    the caller and one helper thread (image rows split in two).
+//  - Everything runs on the calling thread: the stage is pure (threads live in src/runtime), and
+//    a helper thread over image rows measured no gain.
 
 // The per-pixel loops are written branch-free (selects instead of branches); GCC only turns
 // such selects on float compares into SIMD when it may assume no floating-point traps, which
@@ -27,11 +27,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <condition_variable>
 #include <cstring>
-#include <mutex>
 #include <opencv2/imgproc.hpp>
-#include <thread>
 #include <vector>
 
 namespace stairguide {
@@ -57,9 +54,7 @@ const char* to_string(OdometryStatus s) {
 namespace {
 
 constexpr int kMaxLevels = 6;
-constexpr int kBlock = 256;         // points per accumulation block (its scratch stays in L1)
-constexpr int kParts = 2;           // point lists per level: one per thread
-constexpr int kParallelMin = 8000;  // points (or rows x width) below which two threads do not pay
+constexpr int kBlock = 256;  // points per accumulation block (its scratch stays in L1)
 
 using Mat6d = Eigen::Matrix<double, 6, 6>;
 using Vec6d = Eigen::Matrix<double, 6, 1>;
@@ -83,7 +78,7 @@ struct Pyramid {
   int valid0 = 0;  // full-resolution pixels with depth
 };
 
-/// Points of the reference frame at one level (one part of it), structure of arrays.
+/// Points of the reference frame at one level, structure of arrays.
 struct PointList {
   int n = 0;
   std::vector<float> x, y, z, ia, wa;
@@ -115,21 +110,9 @@ struct Accum {
   double sum_wx2 = 0, sum_w = 0, sum_rI2 = 0, sum_rW2 = 0;
   double sum_tI = 0, sum_tW = 0;  // sum of (nu+1)/(nu+x^2) r^2: Student-t scale fixed point
   void clear() { *this = Accum(); }
-  void add(const Accum& o) {
-    H += o.H;
-    g += o.g;
-    used += o.used;
-    inliers += o.inliers;
-    sum_wx2 += o.sum_wx2;
-    sum_w += o.sum_w;
-    sum_rI2 += o.sum_rI2;
-    sum_rW2 += o.sum_rW2;
-    sum_tI += o.sum_tI;
-    sum_tW += o.sum_tW;
-  }
 };
 
-/// Per-thread scratch of one block.
+/// Scratch of one block.
 struct alignas(64) Scratch {
   alignas(64) float bx[kBlock], by[kBlock], bz[kBlock], fa[kBlock], fb[kBlock], valid[kBlock];
   alignas(64) int idx[kBlock];
@@ -166,64 +149,6 @@ inline float sum8(const float* a, int m) {
   return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
 
-/// One helper thread that runs a job on request; the caller runs its own share meanwhile.
-class Helper {
- public:
-  struct Job {
-    virtual void run() = 0;
-
-   protected:
-    ~Job() = default;
-  };
-  Helper() : thread_([this] { loop(); }) {}
-  ~Helper() {
-    {
-      std::lock_guard<std::mutex> lock(m_);
-      quit_ = true;
-    }
-    cv_.notify_all();
-    thread_.join();
-  }
-  void start(Job* job) {
-    {
-      std::lock_guard<std::mutex> lock(m_);
-      job_ = job;
-    }
-    cv_.notify_all();
-  }
-  void wait() {
-    std::unique_lock<std::mutex> lock(m_);
-    cv_.wait(lock, [this] { return job_ == nullptr; });
-  }
-
- private:
-  void loop() {
-    std::unique_lock<std::mutex> lock(m_);
-    for (;;) {
-      cv_.wait(lock, [this] { return quit_ || job_ != nullptr; });
-      if (quit_) return;
-      Job* j = job_;
-      lock.unlock();
-      j->run();
-      lock.lock();
-      job_ = nullptr;
-      cv_.notify_all();
-    }
-  }
-  std::mutex m_;
-  std::condition_variable cv_;
-  Job* job_ = nullptr;
-  bool quit_ = false;
-  std::thread thread_;
-};
-
-template <class F>
-struct FnJob final : Helper::Job {
-  explicit FnJob(F& f) : fn(f) {}
-  void run() override { fn(); }
-  F& fn;
-};
-
 /// Rotation vector -> rotation matrix (Rodrigues), exact also near zero.
 Eigen::Matrix3d rot_exp(const Eigen::Vector3d& w) {
   const double a = w.norm();
@@ -242,14 +167,13 @@ struct DenseOdometry::Impl {
   OdometryConfig cfg;
   CameraIntrinsics K0;
   int levels = 3;
-  int threads = 1;
   std::array<CameraIntrinsics, kMaxLevels> K;
   std::array<int, kMaxLevels> stride{};
   std::array<float, kMaxLevels> edge_ratio{};  // max |dW| / W between neighbouring pixels
 
   Pyramid pyr[2];
   int ref = 0;  // index of the reference pyramid; the current frame goes into 1 - ref
-  std::array<std::array<PointList, kParts>, kMaxLevels> pts;
+  std::array<PointList, kMaxLevels> pts;
   bool has_ref = false;
   bool sized = false;
 
@@ -264,9 +188,7 @@ struct DenseOdometry::Impl {
   int consecutive_failures = 0;
   bool prev_skipped = false;  // the last output frame was an unusable frame placed by the guess
 
-  std::array<Scratch*, kParts> scratch{};
-  std::vector<Scratch> scratch_store;
-  std::unique_ptr<Helper> helper;
+  Scratch scratch;  // per-block buffers of accumulate()
 
   void setup(const OdometryConfig& c, const CameraIntrinsics& k) {
     cfg = c;
@@ -274,7 +196,6 @@ struct DenseOdometry::Impl {
     levels = std::clamp(c.pyramid_levels, 1, kMaxLevels);
     cfg.iterations = std::clamp(c.iterations, 1, 100);
     cfg.max_points_per_level = std::max(c.max_points_per_level, 100);
-    threads = std::clamp(c.threads, 1, 2);
     // Do not go below ~20 px on a side.
     while (levels > 1 && ((K0.width >> (levels - 1)) < 20 || (K0.height >> (levels - 1)) < 20)) --levels;
     for (int l = 0; l < levels; ++l) {
@@ -287,10 +208,6 @@ struct DenseOdometry::Impl {
       // An inverse-depth step spans 2^l full-resolution pixels at level l.
       edge_ratio[l] = cfg.max_inv_depth_step * static_cast<float>(1 << l);
     }
-    scratch_store.resize(kParts);
-    for (int p = 0; p < kParts; ++p) scratch[p] = &scratch_store[p];
-    if (threads == 2 && !helper) helper = std::make_unique<Helper>();
-    if (threads == 1) helper.reset();
     sized = false;
     has_ref = false;
     forget_motion();
@@ -316,35 +233,17 @@ struct DenseOdometry::Impl {
     gray_buf.create(K0.height, K0.width, CV_8UC1);  // so that a colour-only frame allocates nothing
     for (int l = 0; l < levels; ++l) {
       const int cap = (K[l].width / stride[l] + 1) * (K[l].height / stride[l] + 1);
-      for (auto& part : pts[l]) part.reserve(cap);
+      pts[l].reserve(cap);
     }
     sized = true;
   }
 
-  /// Runs f(part) for part 0..threads-1, part 1 on the helper. Small jobs (`big` false) run
-  /// both parts here: a hand-over costs tens of microseconds, more than a coarse level's work.
-  template <class F>
-  void parallel(F&& f, bool big = true) {
-    if (threads == 2 && !big) {
-      f(0);
-      f(1);
-    } else if (threads == 2) {
-      auto second = [&] { f(1); };
-      FnJob<decltype(second)> job(second);
-      helper->start(&job);
-      f(0);
-      helper->wait();
-    } else {
-      f(0);
-    }
-  }
-
   // ---- pyramid ----------------------------------------------------------------------------
 
-  /// Level 0 of rows [y0, y1): grey to float, depth to inverse depth.
-  static int fill_level0(const cv::Mat& gray, const cv::Mat& depth, Image& I, Image& W, int y0, int y1) {
+  /// Level 0: grey to float, depth to inverse depth. Returns the number of pixels with depth.
+  static int fill_level0(const cv::Mat& gray, const cv::Mat& depth, Image& I, Image& W) {
     int valid = 0;
-    for (int y = y0; y < y1; ++y) {
+    for (int y = 0; y < I.h; ++y) {
       float* Ir = I.row(y);
       float* Wr = W.row(y);
       const float* d = depth.ptr<float>(y);
@@ -365,16 +264,16 @@ struct DenseOdometry::Impl {
     return valid;
   }
 
-  /// 2x2 reduction of rows [y0, y1) of level l (l >= 1). Grey: box mean. Inverse depth: mean of
+  /// 2x2 reduction of level l - 1 into level l (l >= 1). Grey: box mean. Inverse depth: mean of
   /// the valid samples when they agree within the level's edge ratio, else no reading (a mean
   /// across a depth edge is a point that exists in neither surface).
-  void reduce_level(Pyramid& P, int l, int y0, int y1) const {
+  void reduce_level(Pyramid& P, int l) const {
     const Image& Is = P.I[l - 1];
     const Image& Ws = P.W[l - 1];
     Image& I = P.I[l];
     Image& W = P.W[l];
     const float ratio = edge_ratio[l - 1];
-    for (int y = y0; y < y1; ++y) {
+    for (int y = 0; y < I.h; ++y) {
       const float* i0 = Is.row(2 * y);
       const float* i1 = Is.row(2 * y + 1);
       const float* w0 = Ws.row(2 * y);
@@ -401,28 +300,14 @@ struct DenseOdometry::Impl {
 
   /// Builds the pyramid of frame into P. Returns the number of full-resolution depth pixels.
   void build_pyramid(const cv::Mat& gray, const cv::Mat& depth, Pyramid& P) {
-    const int h0 = K[0].height;
-    int valid[2] = {0, 0};
-    parallel([&](int part) {
-      const int y0 = part == 0 ? 0 : h0 / 2;
-      const int y1 = (threads == 1 || part == 1) ? h0 : h0 / 2;
-      valid[part] = fill_level0(gray, depth, P.I[0], P.W[0], y0, y1);
-    });
-    P.valid0 = valid[0] + valid[1];
-    for (int l = 1; l < levels; ++l) {
-      const int h = K[l].height;
-      if (threads == 2 && K[l].width * h >= kParallelMin) {
-        parallel([&](int part) { reduce_level(P, l, part == 0 ? 0 : h / 2, part == 0 ? h / 2 : h); });
-      } else {
-        reduce_level(P, l, 0, h);
-      }
-    }
+    P.valid0 = fill_level0(gray, depth, P.I[0], P.W[0]);
+    for (int l = 1; l < levels; ++l) reduce_level(P, l);
   }
 
   // ---- reference points -------------------------------------------------------------------
 
-  /// Builds the point list of level l from rows [y0, y1) of P (the new reference).
-  void build_points(const Pyramid& P, int l, int y0, int y1, PointList& L) const {
+  /// Builds the point list of level l of P (the new reference).
+  void build_points(const Pyramid& P, int l, PointList& L) const {
     const Image& I = P.I[l];
     const Image& W = P.W[l];
     const CameraIntrinsics& k = K[l];
@@ -430,10 +315,8 @@ struct DenseOdometry::Impl {
     const float ratio2 = 2.f * edge_ratio[l];  // central differences span two pixels
     const float ifx = 1.f / k.fx, ify = 1.f / k.fy;
     int n = 0;
-    // Grid rows are 1, 1 + s, 1 + 2s, ... whatever the split of the rows between threads.
-    const int yfirst = std::max(1, y0);
-    const int ystart = yfirst + (s - (yfirst - 1) % s) % s;
-    for (int y = ystart; y < std::min(y1, I.h - 1); y += s) {
+    // Grid rows are 1, 1 + s, 1 + 2s, ... (the border rows have no central difference).
+    for (int y = 1; y < I.h - 1; y += s) {
       const float* Wr = W.row(y);
       const float* Wu = W.row(y - 1);
       const float* Wd = W.row(y + 1);
@@ -493,20 +376,10 @@ struct DenseOdometry::Impl {
   }
 
   void build_reference(const Pyramid& P) {
-    for (int l = 0; l < levels; ++l) {
-      const int h = K[l].height;
-      if (threads == 2) {
-        parallel(
-            [&](int part) { build_points(P, l, part == 0 ? 0 : h / 2, part == 0 ? h / 2 : h, pts[l][part]); },
-            K[l].width * K[l].height / (stride[l] * stride[l]) >= kParallelMin);
-      } else {
-        build_points(P, l, 0, h, pts[l][0]);
-        pts[l][1].n = 0;
-      }
-    }
+    for (int l = 0; l < levels; ++l) build_points(P, l, pts[l]);
   }
 
-  int ref_points(int l) const { return pts[l][0].n + pts[l][1].n; }
+  int ref_points(int l) const { return pts[l].n; }
 
   // ---- one Gauss-Newton accumulation ------------------------------------------------------
 
@@ -665,7 +538,7 @@ struct DenseOdometry::Impl {
   Solve estimate(const Pyramid& cur, const Eigen::Isometry3d& G0) {
     Solve out;
     Eigen::Isometry3d G = G0;
-    Accum part_acc[kParts];
+    Accum acc;
     // Scales of the weights. The paper fixes them (sigma_I = 5, sigma_W = 0.0025); far from the
     // solution nearly every residual is then an "outlier" and the few that agree by chance steer
     // the step, which narrows the basin of convergence. With adaptive_scale the scales start at
@@ -675,14 +548,7 @@ struct DenseOdometry::Impl {
     if (cfg.adaptive_scale) {
       const int l = levels - 1;
       const Eigen::Isometry3f Gf = G.cast<float>();
-      parallel(
-          [&](int part) {
-            accumulate(pts[l][part], cur.I[l], cur.W[l], K[l], edge_ratio[l], Gf, 1e6f, 1e6f, true,
-                       *scratch[part], part_acc[part]);
-          },
-          ref_points(l) >= kParallelMin);
-      Accum acc = part_acc[0];
-      if (threads == 2) acc.add(part_acc[1]);
+      accumulate(pts[l], cur.I[l], cur.W[l], K[l], edge_ratio[l], Gf, 1e6f, 1e6f, true, scratch, acc);
       if (acc.used > 0) {
         est_I = std::sqrt(acc.sum_rI2 / static_cast<double>(acc.used));
         est_W = std::sqrt(acc.sum_rW2 / static_cast<double>(acc.used));
@@ -703,14 +569,7 @@ struct DenseOdometry::Impl {
         const Eigen::Isometry3f Gf = G.cast<float>();
         const float sI = static_cast<float>(std::max<double>(cfg.sigma_intensity, est_I));
         const float sW = static_cast<float>(std::max<double>(cfg.sigma_inv_depth, est_W));
-        parallel(
-            [&](int part) {
-              accumulate(pts[l][part], cur.I[l], cur.W[l], K[l], edge_ratio[l], Gf, sI, sW, false,
-                         *scratch[part], part_acc[part]);
-            },
-            npts >= kParallelMin);
-        Accum acc = part_acc[0];
-        if (threads == 2) acc.add(part_acc[1]);
+        accumulate(pts[l], cur.I[l], cur.W[l], K[l], edge_ratio[l], Gf, sI, sW, false, scratch, acc);
         out.last = acc;
         if (cfg.adaptive_scale && acc.used > 0) {
           est_I = std::sqrt(acc.sum_tI / static_cast<double>(acc.used));

@@ -321,7 +321,6 @@ struct OdometryConfig {
   float min_valid_fraction = 0.05f; ///< share of pixels with depth needed to track
   float max_translation = 0.3f;     ///< m per frame beyond which the estimate is a failure
   float max_rotation = 0.35f;       ///< rad per frame beyond which the estimate is a failure
-  int threads = 1;                  ///< 1 or 2 threads over image rows
   int max_points_per_level = 20000; ///< pixels per pyramid level (a level with more is subsampled on a grid)
   float max_inv_depth_step = 0.05f; ///< fraction of W between neighbouring full-res pixels = depth edge
   float min_update_translation = 1e-4f;  ///< m, an update below this (and the rotation one) = converged
@@ -342,7 +341,6 @@ struct OdometryConfig {
     v.num(min_valid_fraction, "min_valid_percent", Unit::kPercent, 0.1, 100, "pixels with depth needed to track");
     v.num(max_translation, "max_translation_cm", Unit::kCentimetre, 1, 500, "motion per frame beyond walking = failure");
     v.num(max_rotation, "max_rotation_deg", Unit::kDegree, 1, 180, "rotation per frame beyond walking = failure");
-    v.num(threads, "threads", Unit::kCount, 1, 2, "threads over image rows");
     v.num(max_points_per_level, "max_points_per_level", Unit::kCount, 500, 10000000,
           "pixels used per pyramid level; a level with more is subsampled on a regular grid");
     v.num(max_inv_depth_step, "max_inv_depth_step_percent", Unit::kPercent, 0.5, 100,

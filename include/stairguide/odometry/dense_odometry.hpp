@@ -9,9 +9,9 @@
 /// OdometryConfig::keyframe_max_translation / keyframe_max_rotation of it and it still overlaps
 /// (keyframe_min_overlap); keyframe_max_translation = 0 gives pure frame-to-frame tracking.
 ///
-/// The stage is pure: no threads unless `OdometryConfig::threads == 2` asks for a helper over
-/// image rows, no logging, no I/O, no exceptions on the per-frame path. After the first frame
-/// of a given size, `track()` allocates nothing.
+/// The stage is pure: it runs on the calling thread only (no threads of its own), no logging, no
+/// I/O, no exceptions on the per-frame path. After the first frame of a given size, `track()`
+/// allocates nothing.
 
 #include <Eigen/Core>
 #include <memory>

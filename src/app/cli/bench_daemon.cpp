@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core/utility.hpp>
+
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/runtime/logging.hpp"
@@ -115,6 +117,7 @@ int bench_daemon(Context& ctx) {
       pos.empty() ? "synth:ascending_approach_climb:" + std::to_string(frames_wanted) + ":1" : pos[0];
 
   runtime::setup_logging("warn");  // the runtime's counters would otherwise go to stdout
+  cv::setNumThreads(1);             // as stairguided does at start (see stairguided_main.cpp)
   PipelineConfig config = ctx.config;
   config.runtime.log_level = "warn";
 

@@ -418,37 +418,29 @@ int bench_odometry(Context& ctx) {
   const auto frames = ctx.int_option("--frames", 2, 100000000);
   const auto pos = ctx.positionals(0, 1);
   const std::string input = pos.empty() ? "synth:ascending_approach_climb:150" : pos[0];
-  // One thread first, then two, each against the reference on the same frames.
-  PipelineConfig one = ctx.config, two = ctx.config;
-  one.odometry.threads = 1;
-  two.odometry.threads = 2;
+  // Ours and the reference on the same frames, both on this thread.
   FrameSelection sel;
   sel.max_frames = frames.value_or(0);
-  const SequenceResult r1 = run_sequence(input, one, sel, true);
-  const SequenceResult r2 = run_sequence(input, two, sel, false);
-  const double m1 = percentile(r1.ours.wall_ms, 0.5), m2 = percentile(r2.ours.wall_ms, 0.5);
-  const double mr = percentile(r1.reference.wall_ms, 0.5);
-  const double c1 = percentile(r1.ours.cpu_ms, 0.5), cr = percentile(r1.reference.cpu_ms, 0.5);
+  const SequenceResult r = run_sequence(input, ctx.config, sel, true);
+  const double m1 = percentile(r.ours.wall_ms, 0.5);
+  const double mr = percentile(r.reference.wall_ms, 0.5);
+  const double c1 = percentile(r.ours.cpu_ms, 0.5), cr = percentile(r.reference.cpu_ms, 0.5);
   if (json) {
     std::printf(
         "{\"input\": \"%s\", \"frames\": %ld, \"ours_median_ms\": %.3f, \"ours_p95_ms\": %.3f, "
-        "\"ours_2threads_median_ms\": %.3f, \"reference_median_ms\": %.3f, \"reference_p95_ms\": %.3f, "
+        "\"reference_median_ms\": %.3f, \"reference_p95_ms\": %.3f, "
         "\"ours_median_cpu_ms\": %.3f, \"reference_median_cpu_ms\": %.3f, \"speedup\": %.3f, "
         "\"speedup_cpu\": %.3f}\n",
-        input.c_str(), r1.ours.frames, m1, percentile(r1.ours.wall_ms, 0.95), m2, mr,
-        percentile(r1.reference.wall_ms, 0.95), c1, cr, m1 > 0 ? mr / m1 : 0.0, c1 > 0 ? cr / c1 : 0.0);
+        input.c_str(), r.ours.frames, m1, percentile(r.ours.wall_ms, 0.95), mr,
+        percentile(r.reference.wall_ms, 0.95), c1, cr, m1 > 0 ? mr / m1 : 0.0, c1 > 0 ? cr / c1 : 0.0);
     return 0;
   }
-  std::printf("odometry on %s (%ld frames; ms per frame, wall clock / thread CPU)\n", r1.description.c_str(),
-              r1.ours.frames);
-  std::printf("  ours, 1 thread   median %7.2f / %7.2f  p95 %7.2f\n", m1, c1,
-              percentile(r1.ours.wall_ms, 0.95));
-  std::printf("  ours, 2 threads  median %7.2f            p95 %7.2f\n", m2,
-              percentile(r2.ours.wall_ms, 0.95));
-  std::printf("  RgbdOdometry     median %7.2f / %7.2f  p95 %7.2f\n", mr, cr,
-              percentile(r1.reference.wall_ms, 0.95));
-  std::printf("  speed-up, 1 thread: %.2fx wall, %.2fx cpu\n", m1 > 0 ? mr / m1 : 0.0,
-              c1 > 0 ? cr / c1 : 0.0);
+  std::printf("odometry on %s (%ld frames; ms per frame, wall clock / thread CPU)\n", r.description.c_str(),
+              r.ours.frames);
+  std::printf("  ours          median %7.2f / %7.2f  p95 %7.2f\n", m1, c1, percentile(r.ours.wall_ms, 0.95));
+  std::printf("  RgbdOdometry  median %7.2f / %7.2f  p95 %7.2f\n", mr, cr,
+              percentile(r.reference.wall_ms, 0.95));
+  std::printf("  speed-up: %.2fx wall, %.2fx cpu\n", m1 > 0 ? mr / m1 : 0.0, c1 > 0 ? cr / c1 : 0.0);
   return 0;
 }
 
@@ -461,6 +453,6 @@ SG_COMMAND("eval-odometry",
            "odometry RPE/ATE/time against ground truth, side by side with OpenCV RgbdOdometry",
            cmd_eval_odometry);
 SG_BENCH("odometry", "odometry [INPUT] [--frames N] [--json]",
-         "dense odometry vs OpenCV RgbdOdometry, 1 and 2 threads", bench_odometry);
+         "dense odometry vs OpenCV RgbdOdometry (median/p95 ms per frame, speed-up)", bench_odometry);
 
 }  // namespace stairguide::cli
