@@ -384,8 +384,23 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   }
   const double slope = (n * skh - sk * sh) / (n * skk - sk * sk);
   const float level0 = static_cast<float>((sh - slope * sk) / n);
+  const float riser = std::fabs(static_cast<float>(slope));
   if (scene.remembered_camera_height > 0.f) {
-    run_anchored(scene, K, dir, std::fabs(static_cast<float>(slope)), level0, out);
+    run_anchored(scene, K, dir, riser, level0, scene.remembered_camera_height, out);
+    out.floor_remembered = true;
+    return;
+  }
+  // Cold start, but the floor the user stands on may be in view outside the stack: perception
+  // refused it (the top of a descent: the treads below look nearer the user's feet; a floor strip
+  // that might be a tread), and the stack does not reach it because the first steps are hidden
+  // (self-occluded below a descending edge, under the view at the foot of a climb). A level a
+  // chest camera's height below the camera and a whole number of risers from the first seen level
+  // places the steps from the feet as a remembered height would. Without it, the first seen level
+  // could be any step, and the stack is placed only where the checks below settle it.
+  const float seen = seen_floor_height(dir, riser);
+  if (seen > 0.f) {
+    trace_.floor_seen = true;
+    run_anchored(scene, K, dir, riser, level0, seen, out);
     return;
   }
   model(scene, K, dir, 0, level0, out);
@@ -394,9 +409,8 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   // floor runs to the user's feet, so its near boundary is the image border; a first step whose
   // nosing is in view is no floor. Cut by the border, a tread shows at most its own depth: a level
   // deeper than the tread measured on the others is the floor. Shallower, nothing in one frame
-  // tells a floor strip from a tread seen from above, and a staircase placed one step off is
-  // worse for the user than none: nothing is reported. (Deeper than a tread but shallower than a
-  // landing is left undecided too: on far, grazing views the levels' depths are loose.)
+  // tells a floor strip from a tread seen from above unless the camera's height rules one out,
+  // and a staircase placed one step off is worse for the user than none: nothing is reported.
   if (out.level_data.size() < 2) return;
   {
     const StairLevel& l1 = out.level_data[1];
@@ -405,17 +419,32 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   }
   if (!trace_.first_near_cut) return;
   const float depth = out.level_data[1].depth_max - out.level_data[1].depth_min;
-  const bool deep = depth > std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
+  trace_.first_depth = depth;
   // Seen at a chest camera's pitch (the floor detector's range), the floor the user stands on lies
   // a chest camera's height below it (the same detector's range): a level nearer the camera, or
   // farther, is a step whatever its depth. A camera held level (a hand-held or tripod view) says
   // nothing of its height: there the rule does not apply.
   const float cam_above = -nodes_[static_cast<std::size_t>(chain_[0])].height;
   const bool chest_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
+  // Every tread of a flight has the same depth (building codes allow about 1 cm between the
+  // deepest and the shallowest), so a level seen deeper than the fitted tread plus the measuring
+  // slack is no tread of this flight: it is the floor. From a chest camera the level cut by the
+  // bottom border lies within a metre or so of the camera and its depth is measured to a few cm;
+  // only from a camera held level, whose lowest rows look far and grazing, is anything shallower
+  // than a landing left undecided.
+  const float floor_depth = chest_view && out.tread_m > 0.f ? out.tread_m + kFloorDepthSlack
+                                                             : std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
+  const bool deep = depth > floor_depth;
   const bool floor_height = cam_above >= floor_.height_min - det_.same_level_tolerance &&
                             cam_above <= floor_.height_max + det_.same_level_tolerance;
   if (chest_view && !floor_height) return;
-  if (!deep) {
+  // The other way round: were the level a first tread, the user's floor would lie one riser
+  // below it (ascending) or above it (descending); outside a chest camera's height range that
+  // cannot be the user's floor, so the level is.
+  const float tread_cam = cam_above + static_cast<float>(dir) * out.riser_m;
+  const bool tread_height = tread_cam >= floor_.height_min - det_.same_level_tolerance &&
+                            tread_cam <= floor_.height_max + det_.same_level_tolerance;
+  if (!deep && (!chest_view || tread_height)) {
     out.detected = false;
     out.verdict = StairVerdict::kNoFirstStep;
     return;
@@ -431,14 +460,38 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   model(scene, K, dir, 1, nodes_[static_cast<std::size_t>(chain_[0])].height, out);
 }
 
+float FloorlessStairs::seen_floor_height(int dir, float riser) const {
+  if (chain_.empty() || riser <= 0.f) return 0.f;
+  const float h0 = nodes_[static_cast<std::size_t>(chain_[0])].height;
+  const float tol = det_.same_level_tolerance;
+  const int kmax = 1 + std::max(0, det_.floorless_max_hidden_steps);
+  float best = 0.f;
+  int best_pixels = 0;
+  for (int i : order_) {
+    if (std::find(chain_.begin(), chain_.end(), i) != chain_.end()) continue;
+    const Node& f = nodes_[static_cast<std::size_t>(i)];
+    const float cam_above = -f.height;
+    if (cam_above < floor_.height_min - tol || cam_above > floor_.height_max + tol) continue;
+    // On the user's side of the flight: below its first level ascending, above it descending.
+    const float a0 = static_cast<float>(dir) * (h0 - f.height);
+    const int k = static_cast<int>(std::lround(a0 / riser));
+    if (k < 1 || k > kmax || std::fabs(a0 - static_cast<float>(k) * riser) > det_.floorless_anchor_tolerance) continue;
+    if (f.pixels > best_pixels) {
+      best_pixels = f.pixels;
+      best = cam_above;
+    }
+  }
+  return best;
+}
+
 void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser,
-                                   float level0, StairResult& out) {
-  // The feet lie the remembered camera height below the camera along up (the camera sits at up .
-  // p = 0). chain_ is in stair order: chain_[0] is the first level seen from the user.
+                                   float level0, float camera_height, StairResult& out) {
+  // The feet lie `camera_height` below the camera along up (the camera sits at up . p = 0).
+  // chain_ is in stair order: chain_[0] is the first level seen from the user.
   trace_.anchored = true;
   const int n = static_cast<int>(chain_.size());
   const float h0 = nodes_[static_cast<std::size_t>(chain_[0])].height;
-  const float a0 = static_cast<float>(dir) * (h0 + scene.remembered_camera_height);
+  const float a0 = static_cast<float>(dir) * (h0 + camera_height);
   trace_.first_offset = a0;
   const int kmax = 1 + std::max(0, det_.floorless_max_hidden_steps);
   const int k = riser > 0.f ? static_cast<int>(std::lround(a0 / riser)) : -1;
@@ -476,7 +529,6 @@ void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrins
     }
   }
   out.without_floor = false;
-  out.floor_remembered = true;
 }
 
 void FloorlessStairs::add_hidden_steps(StairResult& out, int dir, int hidden) {

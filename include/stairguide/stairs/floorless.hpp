@@ -77,10 +77,12 @@ struct FloorlessTrace {
   int stacked = 0;                     ///< levels in the longest stack one riser apart
   int direction = 0;                   ///< +1 ascending, -1 descending, 0 undecided
   bool floor_level = false;            ///< the first seen level was taken for the floor (level 0)
-  bool anchored = false;               ///< the camera height was remembered: levels placed from the feet
+  bool anchored = false;               ///< levels placed from the feet (camera height remembered or floor seen)
+  bool floor_seen = false;             ///< cold start: the user's floor seen outside the stack gave the camera height
   int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
   float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
   bool first_near_cut = false;         ///< the first seen level's near boundary lies on the image border
+  float first_depth = 0.f;             ///< m, cold start: depth seen of that level (a floor strip deeper than a tread is the floor)
   int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
   std::vector<float> level_heights;    ///< m, up . p of each stacked level, lowest first
 };
@@ -124,9 +126,14 @@ class FloorlessStairs {
   bool edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const;
   /// The same for the line across level k at `z` along z_S.
   bool line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y, float z) const;
-  /// Anchored to the remembered floor (see the file comment); `level0` is the stack's fitted level 0.
+  /// Anchored to the floor `camera_height` below the camera (remembered or seen; see the file
+  /// comment); `level0` is the stack's fitted level 0.
   void run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser, float level0,
-                    StairResult& out);
+                    float camera_height, StairResult& out);
+  /// Cold start: the camera height above a level outside the stack that can be the user's floor
+  /// (a chest camera's height below, 1..1+max hidden risers from the first seen level on the
+  /// user's side; the biggest such), 0 when there is none.
+  float seen_floor_height(int dir, float riser) const;
   /// Moves a model whose first level is step `hidden + 1` (steps 1..hidden out of view) so that its
   /// origin, heights and indices count from the floor.
   static void add_hidden_steps(StairResult& out, int dir, int hidden);

@@ -117,6 +117,21 @@ int detect(Context& ctx) {
     kv("edge_right", vec3(result.edge_right));
     kv("method", quote(to_string(result.method)));
     kv("without_floor", result.without_floor ? "true" : "false");
+    kv("floor_remembered", result.floor_remembered ? "true" : "false");
+    if (!scene.floor_found) {
+      // What the floorless route saw: why a stack was placed, left unplaced or refused.
+      const FloorlessTrace& t = stage.floorless_trace();
+      std::string heights = "[";
+      for (float h : t.level_heights) heights += (heights.size() > 1 ? ", " : "") + fmt(h);
+      kv("floorless", "{\"up_found\": " + std::string(t.up_found ? "true" : "false") +
+                          ", \"tilt_deg\": " + fmt(rad2deg(t.tilt)) + ", \"levels\": " + fmt(t.levels) +
+                          ", \"stacked\": " + fmt(t.stacked) + ", \"direction\": " + fmt(t.direction) +
+                          ", \"level_heights_m\": " + heights + "], \"first_near_cut\": " +
+                          (t.first_near_cut ? "true" : "false") + ", \"first_depth_m\": " + fmt(t.first_depth) + ", \"floor_level\": " +
+                          (t.floor_level ? "true" : "false") + ", \"floor_seen\": " + (t.floor_seen ? "true" : "false") +
+                          ", \"anchored\": " + (t.anchored ? "true" : "false") + ", \"first_index\": " +
+                          fmt(t.first_index) + "}");
+    }
     kv("candidates", fmt(result.candidates));
     kv("rejected_candidates", fmt(result.rejected_candidates));
     kv("timings_ms", "{\"perception\": " + fmt(perception_ms) + ", \"detection\": " +
