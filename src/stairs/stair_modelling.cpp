@@ -262,6 +262,38 @@ float StairModelling::boundary_median(const std::vector<Eigen::Vector2f>& pts, c
   return boundary_median_ab(ba_, bb_, true, f);
 }
 
+bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& xs, const Eigen::Vector3f& up,
+                              const Eigen::Vector3f& zs, float a_mid, float edge_b, const StairLevel& o,
+                              float plane) const {
+  // A board with a side panel rising above it (a shelf's or a cabinet's bottom board): a vertical
+  // plane facing along the edge at a lateral end of the level, over its depth, reaching above its
+  // surface. One panel is enough: the other is often hidden behind the board or out of view. (A
+  // step between walls looks the same; this is only asked of a level seen too shallow for a step
+  // platform, which was an obstacle anyway before its far side was taken as running out of view.)
+  constexpr float kEndSlack = 0.10f;   // m, a panel this near the level's lateral end bounds it
+  constexpr float kPanelRise = 0.05f;  // m, a panel reaching this far above the level is furniture
+  const float sin_vert = std::sin(cls_.parallel_threshold), cos_side = std::cos(cls_.parallel_threshold);
+  bool left = false, right = false;
+  for (const PlaneRegion& r : scene.regions) {
+    if (r.points.size() < 20 || std::fabs(r.normal.dot(up)) > sin_vert || std::fabs(r.normal.dot(xs)) < cos_side) continue;
+    const float a = xs.dot(r.centroid) - a_mid;
+    const bool at_min = std::fabs(a - o.lateral_min) < kEndSlack, at_max = std::fabs(a - o.lateral_max) < kEndSlack;
+    if (!at_min && !at_max) continue;
+    float top = -1e9f, b_lo = 1e9f, b_hi = -1e9f;
+    const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 200);
+    for (std::size_t i = 0; i < r.points.size(); i += stride) {
+      top = std::max(top, up.dot(r.points[i]) - plane);
+      const float b = zs.dot(r.points[i]) - edge_b;
+      b_lo = std::min(b_lo, b);
+      b_hi = std::max(b_hi, b);
+    }
+    if (top < kPanelRise || b_hi < o.depth_min || b_lo > o.depth_max) continue;
+    left = left || at_max;
+    right = right || at_min;
+  }
+  return left || right;
+}
+
 void StairModelling::refine_single_axis(const Level2d& L, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
                                         const Eigen::Vector3f& e2, const Eigen::Vector3f& up) {
   // The near boundary of a single level is its edge (or, below the user, the straight shadow of
@@ -780,10 +812,19 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     edge_b = efit.ok ? efit.intercept + efit.slope * first : out.level_data[1].edge;
     plane = levels_[1].plane;
   } else {
-    if (efit.ok)
+    if (efit.ok) {
       edge_b = efit.intercept;
-    else
-      edge_b = floor_edge ? fl.edge : (std::isfinite(near_boundary) ? near_boundary : out.level_data[1].depth_min);
+    } else if (floor_edge) {
+      edge_b = fl.edge;
+    } else {
+      edge_b = std::isfinite(near_boundary) ? near_boundary : out.level_data[1].depth_min;
+      // No floor boundary seen at the drop (its edge out of view, or too thin a strip): the
+      // level below is seen from where the edge's shadow ends. From a camera H above the floor,
+      // an edge D ahead hides a drop of R up to D * R / H beyond it, so the strip seen from b on
+      // says the edge lies at b / (1 + R / H) (b counted from the camera's foot, as edge_b is).
+      const float H = -levels_[0].plane;
+      if (n == 1 && H > 0.3f && edge_b > 0.f) edge_b /= 1.f + riser / H;
+    }
     plane = levels_[0].plane;
   }
   const Eigen::Vector3f origin = xs * a_mid + up * plane + zs * edge_b;
@@ -883,9 +924,12 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
                 v > static_cast<float>(K_->height) - margin;
     }
     // Another floor level (a curb) is deeper than a step platform, or runs out of view on both
-    // sides and at the far side; a platform whose far edge is seen is a single step.
-    out.kind = (dir < 0 || depth >= det_.curb_min_depth || (cut == 2 && far_cut)) ? StairKind::kCurb
-                                                                                 : StairKind::kSingleStep;
+    // sides and at the far side (seen shallower than a step platform, only when wider than any
+    // furniture board); a platform whose far edge is seen, or a narrower one running out of view,
+    // is a single step.
+    const bool shallow = depth < det_.single_min_depth - tol;
+    const bool other_floor = cut == 2 && far_cut && (!shallow || width >= kOtherFloorWidth);
+    out.kind = (dir < 0 || depth >= det_.curb_min_depth || other_floor) ? StairKind::kCurb : StairKind::kSingleStep;
     const float min_width = det_.single_min_width;
     // A level below the floor is hidden behind the floor's edge up to the edge's shadow: from the
     // camera (height H above the floor, D in front of the edge) a drop of R is seen from D * R / H
@@ -904,12 +948,11 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
       }
     }
     // Seen shallower than a step platform: an obstacle, unless it runs out of view at the far side
-    // and on both sides while wider than any furniture board (then it is another floor level), or
-    // is the strip of a drop seen past the floor's edge.
-    const bool too_small = width < min_width - tol ||
-                           (depth < det_.single_min_depth - tol &&
-                            !(far_cut && cut == 2 && width >= kOtherFloorWidth) && !shadowed_drop);
-    if (too_small) {
+    // (its depth seen is then only where the view ends: a platform as wide as a step that goes on
+    // beyond the view is one to step onto, whatever lies past it), or is the strip of a drop seen
+    // past the floor's edge.
+    const bool too_small = width < min_width - tol || (shallow && !far_cut && !shadowed_drop);
+    if (too_small || (shallow && !shadowed_drop && dir > 0 && boxed_in(scene, xs, up, zs, a_mid, edge_b, o, levels_[1].plane))) {
       out.verdict = StairVerdict::kObstacle;
       return;
     }

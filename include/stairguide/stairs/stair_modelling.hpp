@@ -75,6 +75,10 @@ class StairModelling {
   float boundary_median(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
                         const BoundaryFrame& f);
   /// Turns z2 so that the near boundary of a single level runs along x.
+  /// True when a vertical panel reaching above the single level `o` stands at one of its lateral
+  /// ends over its depth (a shelf's or cabinet's bottom board). Axes and positions as in validation.
+  bool boxed_in(const SceneResult& scene, const Eigen::Vector3f& xs, const Eigen::Vector3f& up,
+                const Eigen::Vector3f& zs, float a_mid, float edge_b, const StairLevel& o, float plane) const;
   void refine_single_axis(const Level2d& level, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
                           const Eigen::Vector3f& e2, const Eigen::Vector3f& up);
   float robust_low(std::vector<float>& v) const;
