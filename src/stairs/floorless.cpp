@@ -387,7 +387,7 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   const float riser = std::fabs(static_cast<float>(slope));
   if (scene.remembered_camera_height > 0.f) {
     run_anchored(scene, K, dir, riser, level0, scene.remembered_camera_height, out);
-    out.floor_remembered = true;
+    out.floor_remembered = !out.without_floor;  // placed from the feet
     return;
   }
   // Cold start, but the floor the user stands on may be in view outside the stack: perception
@@ -395,8 +395,9 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   // that might be a tread), and the stack does not reach it because the first steps are hidden
   // (self-occluded below a descending edge, under the view at the foot of a climb). A level a
   // chest camera's height below the camera and a whole number of risers from the first seen level
-  // places the steps from the feet as a remembered height would. Without it, the first seen level
-  // could be any step, and the stack is placed only where the checks below settle it.
+  // places the steps from the feet as a remembered height would. Without it, the checks below
+  // settle whether the first seen level is the floor; otherwise its step number is unknown and the
+  // stack is reported without_floor or refused.
   const float seen = seen_floor_height(dir, riser);
   if (seen > 0.f) {
     trace_.floor_seen = true;

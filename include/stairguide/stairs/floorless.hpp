@@ -44,14 +44,21 @@
 /// result is a normal detection (`without_floor` false, `floor_remembered` set): heights from the
 /// floor, the origin on the first step's edge, the distance known.
 ///
-/// *Cold start* (nothing remembered): the result has `without_floor` set: heights are relative to
-/// the first seen level, and the distance from the user's feet is unknown. The first level seen
-/// whose near boundary the image border cuts may be the floor the user stands on (the floor
-/// detector refused it) or the first step seen from above: deeper than the fitted tread (plus
-/// slack) and than a landing it is the floor and becomes level 0; seen at a chest camera's pitch
-/// (FloorConfig tilt range) from outside a chest camera's height above it (FloorConfig height
-/// range) it is a step; otherwise nothing says which, and no staircase is reported (kNoFirstStep)
-/// rather than one step off. A first level whose near boundary is in view is a step.
+/// *Cold start* (nothing remembered). A level outside the stack that can be the user's floor (a
+/// chest camera's height below the camera, FloorConfig height range, and 1..1 +
+/// `floorless_max_hidden_steps` risers from the first seen level on the user's side; the floor
+/// perception refused, e.g. at the top of a descent whose first treads are self-occluded) anchors
+/// the stack as a remembered height does (`without_floor` false, trace `floor_seen`). Otherwise
+/// the result has `without_floor` set: heights are relative to the first seen level, and the
+/// distance from the user's feet and the first seen level's step number are unknown. The first
+/// level seen whose near boundary the image border cuts may be the floor the user stands on (the
+/// floor detector refused it) or the first step seen from above. It is the floor (level 0) when
+/// deeper than the fitted tread plus slack (a flight's treads are all one depth; from a camera
+/// held level, also deeper than a landing), or when, seen at a chest camera's pitch (FloorConfig
+/// tilt range), a first tread there would put the user's floor outside a chest camera's height
+/// range. It is a step when the camera is outside that range above it. Otherwise nothing says
+/// which, and no staircase is reported (kNoFirstStep) rather than one step off. A first level
+/// whose near boundary is in view is a step.
 ///
 /// Pure: no I/O, no exceptions; buffers are kept between frames.
 
