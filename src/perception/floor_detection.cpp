@@ -106,6 +106,47 @@ bool FloorDetector::nothing_below(const PlaneRegion& r, const Reach& near) const
   return below < static_cast<float>(cfg_.verify_min_pixels);
 }
 
+bool FloorDetector::drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame) const {
+  // A first tread whose near edge is in view shows right under that edge, in the same image
+  // columns, the top few cm of its riser: lower than the tread but hardly nearer the nadir, so
+  // nothing_below's margin misses it. Column by column, walking up from the view's bottom to the
+  // first pixel on the candidate's plane (its near edge in that column): the floor the user
+  // stands on has nothing lower just under it (it reaches the view's border, or continues, or
+  // things stand on it). Walking the depth image column by column costs a few hundred pixels per
+  // column where the edge is in view, far less than the region's pixel list.
+  constexpr float kDrop = 0.025f;  // m, below the candidate by more than its noise
+  constexpr int kRows = 16;        // px under the edge where a drop counts
+  constexpr int kColStep = 4;      // px between the columns looked at
+  const cv::Mat& D = frame.depth;
+  if (D.empty() || D.type() != CV_32FC1) return false;
+  const int W = D.cols, H = D.rows;
+  const CameraIntrinsics& K = frame.intrinsics;
+  int columns = 0, dropped = 0;
+  for (int u = 0; u < W; u += kColStep) {
+    const float un = (static_cast<float>(u) - K.cx) / K.fx;
+    int drop_row = -1;  // the highest row seen so far with a point clearly below the plane
+    for (int v = H - 1; v >= 0; --v) {
+      const float z = D.at<float>(v, u);
+      if (!(z > 0.f) || !std::isfinite(z)) continue;
+      const Eigen::Vector3f q(un * z, (static_cast<float>(v) - K.cy) / K.fy * z, z);
+      const float h = r.normal.dot(q) + r.offset;
+      if (h < -kDrop) {
+        drop_row = v;
+        continue;
+      }
+      if (h > cfg_.inlier_distance) continue;
+      // On the plane: its nearest row in this column.
+      if (v < H - 3) {
+        ++columns;
+        if (drop_row >= 0 && drop_row - v <= kRows + 2) ++dropped;
+      }
+      break;
+    }
+  }
+  // A riser runs along the tread's whole edge; a stray hole or a cable does not.
+  return columns >= 8 && dropped * 2 >= columns;
+}
+
 bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width) {
   // A plane that starts at the bottom of the view (we cannot see what the user stands on) with
   // another plane one riser above or below it starting a tread's depth further: the first tread
@@ -226,7 +267,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     if (chosen < 0) break;
     const PlaneRegion& f = regions[chosen];
     const Reach near = reach(f);
-    const bool clear = nothing_below(f, near);
+    const bool clear = nothing_below(f, near) && !drop_under_edge(f, frame);
     // The tracked floor has been told from the steps already: no ambiguity left.
     const bool stair = clear && !tracked && stair_from_view_edge(regions, chosen, near, frame.depth.cols);
     if (clear && !stair) {

@@ -84,6 +84,7 @@ class FloorDetector {
   int lost_frames_ = 0;
   void sample_frame(const RgbdFrame& frame);
   bool nothing_below(const PlaneRegion& r, const Reach& near) const;
+  bool drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame) const;
   bool stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width);
   std::vector<int> col_top_;
   CameraIntrinsics K_;
