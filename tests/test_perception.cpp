@@ -462,7 +462,15 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
             const PlaneRegion& R = sc.regions[r];
             if (std::fabs(R.normal.dot(up)) < std::cos(10 * kDeg)) continue;
             const Eigen::Vector3f cs = T_sc * R.centroid;
-            if (std::fabs(cs.y() + b_opt - h_opt) > 0.05f || std::fabs(cs.x()) > 0.5f * st.width_m + 0.1f) continue;
+            if (std::fabs(cs.y() + b_opt - h_opt) > 0.05f) continue;
+            // The landing or floor after the last riser (tread `steps`) is wider than the flight,
+            // and the truth counts its pixels beside the flight too (on a descent the part right
+            // after the last riser hides behind the treads above, and what is seen of the lower
+            // floor is beside the flight): it is matched anywhere beyond the last riser. Treads
+            // of the flight must lie within its width.
+            if (k == st.steps && st.kind != StairKind::kCurb ? cs.z() < (st.steps - 1) * st.tread_m - 0.05f
+                                                             : std::fabs(cs.x()) > 0.5f * st.width_m + 0.1f)
+              continue;
             if (best < 0 || R.pixel_count > sc.regions[best].pixel_count) best = r, Hs = h_opt, by = b_opt;
           }
           if (best >= 0) break;
@@ -608,10 +616,19 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_GE(A.floor_ok, 0.99 * A.floor_visible) << "floor found where it is visible";
     EXPECT_EQ(Totals::sequences().all.floor_ok, Totals::sequences().all.floor_visible)
         << "floor found where it is visible, walking sequences";
-    // 498/502 (99.2 %) measured (treads with >= 200 pixels that keep a depth reading); 485/537
-    // before thin strips were seeded on dominant directions and before the truth left out tread
-    // pixels the sensor gives no depth for (grazing incidence, mixed pixels behind nosings).
+    // 501/502 (99.8 %) measured (treads with >= 200 pixels that keep a depth reading); 498/502
+    // before tread/riser crease strips and tread slivers at the top border were split off, and
+    // before the landing after the last riser was matched beside the flight; 485/537 before thin
+    // strips were seeded on dominant directions and before the truth left out tread pixels the
+    // sensor gives no depth for (grazing incidence, mixed pixels behind nosings).
     EXPECT_GE(A.treads_ok, 0.99 * A.treads) << "treads found over all static presets";
+    EXPECT_GE(A.treads_ok, A.treads - 1) << "treads found over all static presets (measured 501/502)";
+    // Manhattan: 143/143 measured (yaw within 2 deg wherever a frame is reported, and reported on
+    // 143 views where a staircase or a corridor is in view; people_static #0 shows only people
+    // and posts, whose planes disagree by degrees, and reports none). 143/144 before votes were
+    // weighted by width and a frame needed one agreeing plane 60 cm wide or a tight agreement.
+    EXPECT_EQ(A.manhattan_ok, A.manhattan_checked) << "Manhattan yaw within 2 deg, static presets";
+    EXPECT_GE(A.manhattan_ok, 143) << "Manhattan frame found on the views with structure";
   }
 };
 const auto* const kTotals = ::testing::AddGlobalTestEnvironment(new TotalsCheck);
@@ -636,7 +653,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     EXPECT_GE(F.floor_ok, std::min(0.99 * F.floor_visible, F.floor_visible - 2.0)) << "floor found within 2 cm / 1 deg";
   }
   EXPECT_EQ(F.mixed, 0) << "a region mixes two levels";
-  EXPECT_GE(F.manhattan_ok, F.manhattan_checked - 1) << "Manhattan yaw within 2 deg";
+  EXPECT_EQ(F.manhattan_ok, F.manhattan_checked) << "Manhattan yaw within 2 deg";
   // Known gaps, held as regression floors (the issue asks for 0 and 100 %): a frame without a
   // visible floor may still take the nearest big horizontal plane (a seat, a tread) for it, and
   // far or thin treads are sometimes split or missed.
@@ -651,14 +668,12 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
   if (length <= 1) {
     // Measured with the seeds above (treads ok / treads), held with one tread of slack. Horizontal
     // regions take the floor's normal (classify_regions), so every tread found has a normal within
-    // the floor's error. The four misses: tread slivers one to five rows tall at the top of the
-    // image, or behind a protruding nosing, taken into the riser below them (rotated #0,
-    // people #3, nosing_landing #11), and descending #23's lower floor, found but wider than the
-    // staircase (its centroid lies outside the flight).
+    // the floor's error. The one miss (nosing_landing #11): a triangle of tread 2 of the far
+    // staircase, 9 rows tall at an occlusion edge, taken into the riser and nosing region below it.
     static const std::map<std::string, std::pair<int, int>> measured = {
-        {"ascending_static", {51, 51}},     {"descending_static", {105, 106}},
+        {"ascending_static", {51, 51}},     {"descending_static", {106, 106}},
         {"open_risers_static", {51, 51}},   {"nosing_landing_static", {51, 52}},
-        {"rotated_static", {52, 53}},       {"people_static", {89, 90}},
+        {"rotated_static", {53, 53}},       {"people_static", {90, 90}},
         {"handrails_open_sides_static", {38, 38}}, {"single_step_static", {16, 16}},
         {"curb_static", {7, 7}},            {"ascending_short_static", {38, 38}}};
     const auto it = measured.find(preset);
@@ -906,4 +921,66 @@ TEST(PerceptionRealData, BigPlanesWholeCurvedSurfacesObstacles) {
       EXPECT_LE(sc.regions.size(), 130u) << "kitchen frame " << i << " (was 160-181)";
     }
   }
+}
+
+// The Manhattan frame on real data: the kitchen's walls and cupboards do not move, so k_M carried
+// into the world by the sequence's ground-truth poses must keep one direction (modulo 90 degrees
+// about the vertical) from view to view, each view on its own. This checks the yaw where the
+// synthetic truth cannot: real walls, real noise, a hand-held camera.
+TEST(PerceptionRealData, KitchenManhattanFrameHoldsStillInTheWorld) {
+  const std::string kitchen = std::string(STAIRGUIDE_SHARED_DATA) + "/7scenes-redkitchen-0000-0299";
+  std::ifstream depth_list(kitchen + "/depth.txt"), poses(kitchen + "/groundtruth.txt");
+  if (!depth_list || !poses) GTEST_SKIP() << "no 7-Scenes kitchen under " << STAIRGUIDE_SHARED_DATA;
+  std::vector<std::string> files;
+  std::vector<Eigen::Matrix3f> R_wc;
+  std::string line;
+  while (std::getline(depth_list, line))
+    if (!line.empty() && line[0] != '#') files.push_back(line.substr(line.find(' ') + 1));
+  while (std::getline(poses, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream in(line);
+    double t, x, y, z, qx, qy, qz, qw;
+    in >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
+    R_wc.push_back(Eigen::Quaternionf(static_cast<float>(qw), static_cast<float>(qx), static_cast<float>(qy),
+                                      static_cast<float>(qz))
+                       .normalized()
+                       .toRotationMatrix());
+  }
+  ASSERT_EQ(files.size(), R_wc.size());
+  std::vector<Eigen::Vector3f> k_world, up_world;
+  for (std::size_t i = 0; i < files.size(); i += 10) {
+    const RgbdFrame f = read_depth_png_frame(kitchen + "/" + files[i]);
+    Perception P;  // each view on its own: nothing carried over
+    SceneResult sc;
+    P.process(f, sc);
+    if (!sc.floor_found || !sc.manhattan_found) continue;
+    const Eigen::Matrix3f R_fc = sc.T_floor_camera.linear();  // camera into floor
+    const Eigen::Vector3f k_f(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw));
+    k_world.push_back(R_wc[i] * (R_fc.transpose() * k_f));
+    up_world.push_back(R_wc[i] * (R_fc.transpose() * Eigen::Vector3f::UnitY()));
+  }
+  // Measured: 16 of the 30 views (the others have no floor in view, or too little wall), every
+  // one within 1.68 degrees of the views' mean.
+  ASSERT_GE(k_world.size(), 13u) << "Manhattan frame found on too few kitchen views";
+  Eigen::Vector3f u = Eigen::Vector3f::Zero();
+  for (const auto& v : up_world) u += v;
+  u.normalize();
+  Eigen::Vector3f e = Eigen::Vector3f::UnitX() - u * u.x();
+  if (e.norm() < 0.1f) e = Eigen::Vector3f::UnitZ() - u * u.z();
+  e.normalize();
+  const Eigen::Vector3f e2 = u.cross(e);
+  // Yaw about the mean vertical, period 90 degrees: circular mean of 4 * yaw.
+  std::vector<float> yaw;
+  float c = 0.f, s = 0.f;
+  for (const auto& k : k_world) {
+    yaw.push_back(std::atan2(e2.dot(k), e.dot(k)));
+    c += std::cos(4.f * yaw.back());
+    s += std::sin(4.f * yaw.back());
+  }
+  const float mean = 0.25f * std::atan2(s, c);
+  float worst = 0.f;
+  for (float a : yaw) worst = std::max(worst, std::fabs(wrap45(a - mean)));
+  std::printf("kitchen: Manhattan frame on %zu of %zu views; world yaw within %.2f deg of the mean\n", k_world.size(),
+              (files.size() + 9) / 10, worst / kDeg);
+  EXPECT_LE(worst / kDeg, 2.5f);
 }

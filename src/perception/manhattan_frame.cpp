@@ -1,5 +1,6 @@
 #include "stairguide/perception/manhattan_frame.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace stairguide {
@@ -32,20 +33,38 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   float hist[kBins] = {};
   float total_area = 0.f;
   struct Vote {
-    float a, w;
+    float a, w, area, width;
   };
   std::vector<Vote> votes;
   votes.reserve(regions.size());
+  // Up in camera coordinates: the horizontal direction within a vertical plane is up x normal.
+  const Eigen::Vector3f up_c = R.transpose() * Eigen::Vector3f::UnitY();
+  const float full_w = std::max(cfg_.yaw_full_width, 1e-3f);
   for (const PlaneRegion& r : regions) {
     total_area += r.area;
     const Eigen::Vector3f nf = R * r.normal;
     if (std::fabs(nf.y()) > sin_tol) continue;
     const float a = wrap_quarter(std::atan2(nf.x(), nf.z()));
-    votes.push_back({a, r.area});
+    // Horizontal width of the region: the spread of its points along the horizontal in its plane.
+    const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
+    float lo = 0.f, hi = 0.f;
+    if (!r.points.empty()) lo = hi = hz.dot(r.points.front());
+    for (const Eigen::Vector3f& q : r.points) {
+      const float t = hz.dot(q);
+      lo = std::min(lo, t);
+      hi = std::max(hi, t);
+    }
+    const float width = hi - lo;
+    // The yaw of a plane fit is as precise as the plane is wide (lever arm): a person's front,
+    // a post or the side of a box a few decimetres wide is off by degrees where a wall or a
+    // riser is not. Votes weigh area * (width / full width)^2, the inverse of that variance.
+    const float s = std::min(1.f, width / full_w);
+    const float w = r.area * s * s;
+    votes.push_back({a, w, r.area, width});
     int bin = static_cast<int>((a + 0.25f * kPi) / kHalfPi * kBins);
     bin = (bin % kBins + kBins) % kBins;
     // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
-    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += r.area * (3 - std::abs(k));
+    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += w * (3 - std::abs(k));
   }
   if (votes.empty()) {
     est.why = "no vertical plane";
@@ -56,17 +75,31 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     if (hist[b] > hist[peak]) peak = b;
   const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
-  float sc = 0.f, ss = 0.f, agree = 0.f;
+  float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f, widest = 0.f;
   for (const Vote& v : votes) {
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     sc += v.w * std::cos(4.f * v.a);
     ss += v.w * std::sin(4.f * v.a);
-    agree += v.w;
+    agree += v.area;
+    wsum_agree += v.w;
+    widest = std::max(widest, v.width);
   }
   est.vertical_area = agree;
   est.fraction = total_area > 0.f ? agree / total_area : 0.f;
   if (agree < cfg_.min_area || est.fraction < cfg_.min_points_fraction) {
     est.why = "too little vertical plane area for a Manhattan frame";
+    return est;
+  }
+  // A frame is trusted when a wide plane (a wall, a riser) supports it, or when the narrow ones
+  // agree tightly (a strip of wall at the view's edge). People, posts and the sides of boxes are
+  // narrow and agree only to degrees: their yaw is no frame. (The spread check alone refused
+  // most real kitchen views, whose walls and cupboards agree only to a few degrees; the width
+  // check alone refused a corridor seen as a 35 cm strip of wall.)
+  const float wsum = std::max(wsum_agree, 1e-12f);
+  const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
+  const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
+  if (widest < cfg_.min_plane_width && spread > cfg_.max_spread) {
+    est.why = "no wide vertical plane, and the narrow ones disagree by degrees (no wall or riser in view)";
     return est;
   }
   float yaw = wrap_quarter(0.25f * std::atan2(ss, sc));

@@ -438,6 +438,269 @@ static double InvDepthMomentsMsr(const InvDepthMoments& m, double a, double b, d
   return std::max(0.0, s / m.n);
 }
 
+namespace {
+/// Moments of the points in `a` that are not in `b` (b a subset of a).
+InvDepthMoments moments_minus(const InvDepthMoments& a, const InvDepthMoments& b) {
+  InvDepthMoments m = a;
+  m.n -= b.n; m.su -= b.su; m.sv -= b.sv; m.sw -= b.sw; m.suu -= b.suu; m.suv -= b.suv; m.svv -= b.svv;
+  m.suw -= b.suw; m.svw -= b.svw; m.sww -= b.sww;
+  return m;
+}
+/// Sum of squared inverse-depth residuals of a fit (rms_w is per point).
+double fit_ssr(const PlaneFit& f, const InvDepthMoments& m) { return m.n * double(f.rms_w) * f.rms_w; }
+// Split passes: smallest side of a split (pixels), and the drop of the summed squared residual
+// (in squared noise sigmas) a split must bring. A split adds one plane offset and a choice of
+// line; on one plane, noise alone lowers the residual by a few sigma^2 at most over all choices.
+constexpr double kSplitMinSide = 24;
+constexpr double kSplitGain = 60;
+constexpr int kBorderBandRows = 6;  // slivers of up to this many rows at the top of the view
+}  // namespace
+
+bool Segmentation::move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir) {
+  Grow ng;
+  for (int p : pixels) {
+    const int v = row_of(p), u = p - v * W_;
+    ng.m.add(un_[u], vn_[v], w_[p]);
+  }
+  const PlaneFit fn = fit_plane_fixed_normal(ng.m, dirs_[dir]);
+  const InvDepthMoments rest = moments_minus(grows[r].m, ng.m);
+  if (!fn.ok || rest.n < 3) return false;
+  const int id = static_cast<int>(grows.size());
+  for (int p : pixels) label_[p] = id;
+  ng.plane = fn;
+  ng.dir = dir;
+  ng.count = static_cast<int>(pixels.size());
+  Grow& g = grows[r];
+  g.m = rest;
+  g.count -= ng.count;
+  // Cells of the region no longer hold one label: the later passes must visit their pixels.
+  for (int& cl : cell_label_)
+    if (cl == r) cl = -1;
+  grows.push_back(ng);
+  return true;
+}
+
+void Segmentation::split_creases(std::vector<Grow>& grows) {
+  // At range, a cell across the edge between a tread and its riser (a few rows of each) is
+  // planar within the noise: it grows into a strip whose plane is a blend of the two (tilted by
+  // tens of degrees), and merging puts it into the tread or the riser, pulling that plane's edge.
+  // Such a strip is split along the crease line of the two dominant directions whose blend it is:
+  // the sweep across that line picks the split that best explains each side by one direction.
+  if (dirs_.size() < 2) return;
+  const int cs = std::max(2, cfg_.cell_size_px);
+  const float cos_own = std::cos(cfg_.region_angle);
+  const float cos_pair = std::cos(60.f * 3.14159265f / 180.f);
+  const float sin_line = std::sin(10.f * 3.14159265f / 180.f);
+  const float limit = 0.5f * tolerance_w();
+  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
+  const int ng = static_cast<int>(grows.size());
+  const int nd = static_cast<int>(dirs_.size());
+  // Candidates and their direction pairs, from the moments alone.
+  using Cand = SplitCand;  // r, direction pairs, image box holding the strip (moments + margin)
+  std::vector<Cand>& cands = split_cands_;
+  cands.clear();
+  for (int r = 0; r < ng; ++r) {
+    const Grow& g = grows[r];
+    if (g.count < 2 * kSplitMinSide || g.dir >= 0 || !g.plane.ok) continue;
+    const InvDepthMoments& m = g.m;
+    const Eigen::Vector3f nr = g.plane.normal;
+    bool on_dir = false;
+    for (const Eigen::Vector3f& d : dirs_) on_dir |= std::fabs(d.dot(nr)) > cos_own;
+    if (on_dir) continue;
+    // The split can lower the summed squared residual by at most all of it.
+    if (fit_ssr(g.plane, m) < kSplitGain * sig2) continue;
+    // A strip one cell row tall (what the cell pass grows across a crease), wider than tall (the
+    // crease runs along the image rows, give or take the staircase's yaw and the camera's roll).
+    // Its height from the moments: rows spread evenly over h have variance h^2 / 12.
+    const double in = 1.0 / m.n;
+    const double mv = m.sv * in, mu = m.su * in;
+    const double sv2 = (m.svv * in - mv * mv) * double(K_.fy) * K_.fy;
+    const double su2 = (m.suu * in - mu * mu) * double(K_.fx) * K_.fx;
+    if (sv2 > su2 || 12.0 * sv2 > 1.25 * 1.25 * cs * cs) continue;
+    Cand c{r, 0, {}, 0, 0, 0, 0};
+    // The two pairs whose crease line the strip's plane holds best (each sweep costs a pass over
+    // the strip; real frames have a few hundred such strips).
+    float off[2] = {sin_line, sin_line};
+    for (int i = 0; i < nd; ++i)
+      for (int j = i + 1; j < nd; ++j) {
+        const float cij = dirs_[i].dot(dirs_[j]);
+        if (std::fabs(cij) > cos_pair) continue;
+        const Eigen::Vector3f t = dirs_[i].cross(dirs_[j]).normalized();
+        const float o = std::fabs(t.dot(nr));
+        if (o > off[1]) continue;  // the strip's plane does not hold the crease (or two hold it better)
+        // The crease must run along the strip (within 30 degrees of the image rows): one across
+        // it (a wall corner) does not make a strip a few rows tall.
+        const Eigen::Vector3f& P = g.plane.mean;
+        const float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
+        if (std::fabs(dv) > 0.5f * std::sqrt(du * du + dv * dv)) continue;
+        // The strip's normal must lie between the two (a blend of both), not beyond either.
+        const float ci = nr.dot(dirs_[i]), cj = nr.dot(dirs_[j]);
+        const float det = 1.f - cij * cij;
+        const float al = (ci - cij * cj) / det, be = (cj - cij * ci) / det;
+        if (!(al > 0.f && be > 0.f)) continue;
+        const int at = o < off[0] ? 0 : 1;
+        if (at == 0) off[1] = off[0], c.pairs[1][0] = c.pairs[0][0], c.pairs[1][1] = c.pairs[0][1];
+        off[at] = o, c.pairs[at][0] = i, c.pairs[at][1] = j;
+        c.np = std::min(2, c.np + 1);
+      }
+    if (c.np == 0) continue;
+    // Uniform spread over an extent e has variance e^2 / 12: the box is 1.5 times that, plus a cell.
+    const double hv = 1.5 * std::sqrt(3.0 * std::max(0.0, sv2)), hu = 1.5 * std::sqrt(3.0 * std::max(0.0, su2));
+    const double vc = mv * K_.fy + K_.cy, uc = mu * K_.fx + K_.cx;
+    c.v0 = std::max(0, static_cast<int>(vc - hv) - cs), c.v1 = std::min(H_ - 1, static_cast<int>(vc + hv) + cs);
+    c.u0 = std::max(0, static_cast<int>(uc - hu) - cs), c.u1 = std::min(W_ - 1, static_cast<int>(uc + hu) + cs);
+    cands.push_back(c);
+  }
+  std::vector<int>& pix = split_pixels_;
+  std::vector<int>& side_a = split_side_;
+  for (const Cand& cd : cands) {
+    const int r = cd.r;
+    pix.clear();
+    for (int v = cd.v0; v <= cd.v1; ++v) {
+      const int* lab = &label_[static_cast<std::size_t>(v) * W_];
+      for (int u = cd.u0; u <= cd.u1; ++u)
+        if (lab[u] == r) pix.push_back(v * W_ + u);
+    }
+    if (static_cast<int>(pix.size()) != grows[r].count) continue;  // not all inside the box: leave it
+    const int p0 = 0, p1 = static_cast<int>(pix.size());
+    const InvDepthMoments m = grows[r].m;
+    const PlaneFit joint = fit_plane(m);
+    if (!joint.ok) continue;
+    const double ssr_joint = fit_ssr(joint, m);
+    double best = ssr_joint;
+    int best_pair = -1, best_k = 0, best_o = 0;
+    float best_eu = 0, best_ev = 0, best_smin = 0;
+    const Eigen::Vector3f P = grows[r].plane.mean;
+    for (int pi = 0; pi < cd.np; ++pi) {
+      const Eigen::Vector3f t = dirs_[cd.pairs[pi][0]].cross(dirs_[cd.pairs[pi][1]]).normalized();
+      // Image direction of the crease line through the strip's centre, in pixels.
+      float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
+      const float ln = std::sqrt(du * du + dv * dv);
+      if (!(ln > 1e-9f)) continue;
+      du /= ln, dv /= ln;
+      const float eu = -dv, ev = du;  // across the line
+      float smin = 1e30f, smax = -1e30f;
+      for (int k = p0; k < p1; ++k) {
+        const int p = pix[k], v = row_of(p), u = p - v * W_;
+        const float s = eu * u + ev * v;
+        smin = std::min(smin, s), smax = std::max(smax, s);
+      }
+      const int nb = static_cast<int>(smax - smin) + 1;
+      if (nb < 2 || nb > 4096) continue;
+      bins_.assign(static_cast<std::size_t>(nb), InvDepthMoments{});
+      for (int k = p0; k < p1; ++k) {
+        const int p = pix[k], v = row_of(p), u = p - v * W_;
+        bins_[static_cast<std::size_t>(eu * u + ev * v - smin)].add(un_[u], vn_[v], w_[p]);
+      }
+      InvDepthMoments A;
+      for (int k = 1; k < nb; ++k) {
+        A.add(bins_[static_cast<std::size_t>(k - 1)]);
+        if (A.n < kSplitMinSide || m.n - A.n < kSplitMinSide) continue;
+        const InvDepthMoments B = moments_minus(m, A);
+        for (int o = 0; o < 2; ++o) {
+          const PlaneFit fa = fit_plane_fixed_normal(A, dirs_[cd.pairs[pi][o]]);
+          if (!fa.ok || fa.rms_w > limit) continue;
+          const PlaneFit fb = fit_plane_fixed_normal(B, dirs_[cd.pairs[pi][1 - o]]);
+          if (!fb.ok || fb.rms_w > limit) continue;
+          const double ssr = fit_ssr(fa, A) + fit_ssr(fb, B);
+          if (ssr < best) best = ssr, best_pair = pi, best_k = k, best_o = o, best_eu = eu, best_ev = ev, best_smin = smin;
+        }
+      }
+    }
+    if (best_pair < 0 || (ssr_joint - best) < kSplitGain * sig2) continue;
+    // Side A (sweep bins below best_k) and side B; the bigger side keeps the region's id.
+    const int da = cd.pairs[best_pair][best_o], db = cd.pairs[best_pair][1 - best_o];
+    int na = 0;
+    for (int k = p0; k < p1; ++k) {
+      const int p = pix[k], v = row_of(p), u = p - v * W_;
+      na += static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k;
+    }
+    const bool move_a = 2 * na <= p1 - p0;
+    side_a.clear();
+    for (int k = p0; k < p1; ++k) {
+      const int p = pix[k], v = row_of(p), u = p - v * W_;
+      if ((static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k) == move_a) side_a.push_back(p);
+    }
+    const int keep_dir = move_a ? db : da, move_dir = move_a ? da : db;
+    if (!move_to_new_region(grows, r, side_a, move_dir)) continue;
+    const PlaneFit fk = fit_plane_fixed_normal(grows[r].m, dirs_[keep_dir]);
+    if (fk.ok) grows[r].plane = fk, grows[r].dir = keep_dir;
+    ++stats_.crease_splits;
+  }
+}
+
+void Segmentation::split_border_bands(std::vector<Grow>& grows) {
+  // A tread seen as a sliver of one to a few rows at the top of the view, above its riser: each
+  // pixel is within the noise of the riser's plane (near the crease the two planes are a few
+  // millimetres apart, and at 3 m the noise is 1.5 cm), so the riser's region takes the sliver.
+  // Together the sliver's pixels are clearly off the riser's plane and on a dominant direction:
+  // split the band of rows off when that explains the region better by many noise sigmas.
+  if (dirs_.empty() || H_ < 2 * kBorderBandRows) return;
+  const int K = kBorderBandRows;
+  const int n = static_cast<int>(grows.size());
+  std::vector<int>& slot = cid_;
+  slot.assign(static_cast<std::size_t>(n), -1);
+  std::vector<int>& regs = live_;
+  regs.clear();
+  for (int u = 0; u < W_; ++u) {
+    const int l = label_[u];
+    if (l >= 0 && slot[l] < 0 && grows[l].count >= cfg_.region_min_pixels + static_cast<int>(kSplitMinSide)) {
+      slot[l] = static_cast<int>(regs.size());
+      regs.push_back(l);
+    }
+  }
+  if (regs.empty()) return;
+  bins_.assign(regs.size() * K, InvDepthMoments{});
+  for (int v = 0; v < K; ++v) {
+    const int* lab = &label_[static_cast<std::size_t>(v) * W_];
+    for (int u = 0; u < W_; ++u) {
+      const int l = lab[u];
+      if (l < 0 || slot[l] < 0) continue;
+      bins_[static_cast<std::size_t>(slot[l]) * K + v].add(un_[u], vn_[v], w_[v * W_ + u]);
+    }
+  }
+  // A crease (a tread above its riser: 90 degrees); oblique directions of clutter do not count.
+  const float cos_pair = std::cos(60.f * 3.14159265f / 180.f);
+  const float limit = 0.5f * tolerance_w();
+  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
+  const int nd = static_cast<int>(dirs_.size());
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const int r = regs[i];
+    const Grow& g = grows[r];
+    const double ssr_joint = g.m.n * InvDepthMomentsMsr(g.m, g.plane.a, g.plane.b, g.plane.c);
+    double best = ssr_joint;
+    int best_k = 0, best_d = -1;
+    InvDepthMoments band;
+    for (int k = 1; k <= K; ++k) {
+      band.add(bins_[i * K + static_cast<std::size_t>(k - 1)]);
+      if (band.n < cfg_.region_min_pixels) continue;
+      const InvDepthMoments rest = moments_minus(g.m, band);
+      if (rest.n < kSplitMinSide) break;
+      const PlaneFit fr = fit_plane(rest);
+      if (!fr.ok) continue;
+      for (int d = 0; d < nd; ++d) {
+        if (std::fabs(dirs_[d].dot(g.plane.normal)) > cos_pair) continue;
+        const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
+        if (!fb.ok || fb.rms_w > limit) continue;
+        const double ssr = fit_ssr(fb, band) + fit_ssr(fr, rest);
+        if (ssr < best) best = ssr, best_k = k, best_d = d;
+      }
+    }
+    if (best_d < 0 || ssr_joint - best < kSplitGain * sig2) continue;
+    std::vector<int>& pix = split_pixels_;
+    pix.clear();
+    for (int v = 0; v < best_k; ++v)
+      for (int u = 0; u < W_; ++u)
+        if (label_[v * W_ + u] == r) pix.push_back(v * W_ + u);
+    if (!move_to_new_region(grows, r, pix, best_d)) continue;
+    Grow& gr = grows[r];
+    int dir = gr.dir;
+    const PlaneFit f = region_plane(gr.m, dir);
+    if (f.ok) gr.plane = f, gr.dir = dir;
+    ++stats_.border_splits;
+  }
+}
+
 void Segmentation::cell_pass(std::vector<Grow>& grows) {
   const int cs = std::max(2, cfg_.cell_size_px);
   CW_ = W_ / cs;
@@ -1295,6 +1558,8 @@ bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions
     seed_pass(cfg_.fine_cell_size_px, grows_);
   stats_.seeds_ms = lap();
   strip_pass(grows_);
+  split_creases(grows_);
+  split_border_bands(grows_);
   stats_.strips_ms = lap();
   stats_.grow_ms = stats_.cells_ms + stats_.seeds_ms + stats_.strips_ms;
   merge_regions(grows_);

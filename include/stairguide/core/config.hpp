@@ -192,6 +192,9 @@ struct ManhattanConfig {
   float min_points_fraction = 0.05f;       ///< share of planar area on Manhattan-aligned vertical planes
   float min_area = 0.03f;                  ///< m^2 of vertical planes needed for a Manhattan frame
   float cluster_tolerance = 0.08726646f;   ///< rad, vertical normals within this of the mode vote for it (5 deg)
+  float yaw_full_width = 1.0f;   ///< m, a vertical plane's vote weighs area * min(1, width / this)^2 (its yaw's precision grows with its width)
+  float min_plane_width = 0.6f;    ///< m, an agreeing vertical plane this wide (a wall, a riser) makes the frame trusted ...
+  float max_spread = 0.02617994f;  ///< rad, ... else the agreeing votes' weighted spread must stay below this (1.5 deg)
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -201,6 +204,12 @@ struct ManhattanConfig {
     v.num(min_area, "min_area_m2", Unit::kNone, 0, 100, "vertical plane area needed for a Manhattan frame, square metres");
     v.num(cluster_tolerance, "cluster_tolerance_deg", Unit::kDegree, 0.5, 44,
           "vertical normals within this of the dominant direction (mod 90 deg) refine it");
+    v.num(yaw_full_width, "yaw_full_width_cm", Unit::kCentimetre, 1, 1000,
+          "a vertical plane's vote weighs area * min(1, horizontal width / this)^2: a narrow plane's yaw is imprecise");
+    v.num(min_plane_width, "min_plane_width_cm", Unit::kCentimetre, 0, 1000,
+          "an agreeing vertical plane this wide (a wall, a riser) makes the frame trusted; people and posts are narrower");
+    v.num(max_spread, "max_spread_deg", Unit::kDegree, 0.1, 45,
+          "without such a plane, the agreeing planes (weighted) may spread this much at most");
   }
 };
 

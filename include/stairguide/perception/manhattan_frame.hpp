@@ -2,7 +2,10 @@
 /// \file manhattan_frame.hpp
 /// Floor-to-Manhattan transform (paper 3.2.2). j_M is the floor's up direction; i_M and k_M are
 /// the two orthogonal horizontal directions that the vertical planes' normals agree with most
-/// (area-weighted vote modulo 90 degrees, refined by a circular mean of the votes near the peak).
+/// (vote modulo 90 degrees weighted by area * (width / yaw_full_width)^2, the precision of a plane's
+/// yaw, refined by a circular mean of the votes near the peak; no frame when no agreeing plane is
+/// min_plane_width wide and the agreeing votes spread more than max_spread, e.g. only people and
+/// posts in view).
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 

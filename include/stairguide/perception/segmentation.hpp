@@ -19,6 +19,11 @@
 ///     lies on a plane parallel to one, within the noise, grows with that normal fixed and only
 ///     its offset fitted; it keeps the fixed normal only while its pixels do not reject it (its
 ///     free fit is not clearly better);
+///  4b. a strip one cell row tall whose plane is a blend of two dominant directions (a cell
+///     across a tread/riser crease at range, planar within the noise) is split along the crease
+///     line of the two; a band of up to a few rows at the top border of the view that lies on
+///     another dominant direction than the rest of its region (a tread sliver taken by its riser)
+///     is split off. Both only where the split lowers the summed squared residual by many sigma^2;
 ///  5. adjacent regions on one plane are merged (each part's mean residual under the union's
 ///     plane within the noise: a small part's own tilt is too rough to extrapolate over a big
 ///     neighbour); small regions that bend smoothly (no depth jump, normals between the merge
@@ -110,6 +115,8 @@ struct SegmentationStats {
   int dominant_directions = 0;  ///< normals the thin-strip seeds may take
   int fixed_normal_regions = 0;  ///< regions grown with a dominant direction's normal
   int curved_tiles = 0;  ///< small regions dropped as facets of a curved surface
+  int crease_splits = 0;  ///< regions split along a crease between two dominant directions
+  int border_splits = 0;  ///< bands at the top border split off their region
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -148,6 +155,15 @@ class Segmentation {
   /// Plane of a region's moments: fixed to its dominant direction while the pixels accept it.
   PlaneFit region_plane(const InvDepthMoments& m, int& dir) const;
   void strip_pass(std::vector<Grow>& grows);
+  /// Splits regions that straddle a crease between two dominant directions (a tread and its
+  /// riser within one cell row, at range) along the crease line.
+  void split_creases(std::vector<Grow>& grows);
+  /// Splits off a band of rows at the top border of the view that lies on another dominant
+  /// direction than the rest of its region (a tread sliver above its riser).
+  void split_border_bands(std::vector<Grow>& grows);
+  /// Moves the pixels of region `r` listed in `pixels` to a new region on direction `dir`.
+  /// Returns false (nothing changed) when the new region's fit fails.
+  bool move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir);
   void merge_regions(std::vector<Grow>& grows);
   void drop_curved_tiles(std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
@@ -203,6 +219,13 @@ class Segmentation {
   std::vector<std::uint16_t> contact_, smooth_;
   std::vector<float> area_;
   std::vector<Eigen::Vector3f> big_dirs_;  // region pairs: seam samples, depth-continuous ones
+  std::vector<InvDepthMoments> bins_;  // split passes: moments per sweep bin / row
+  std::vector<int> split_pixels_, split_side_;
+  struct SplitCand {
+    int r, np, pairs[4][2];
+    int u0, u1, v0, v1;
+  };
+  std::vector<SplitCand> split_cands_;
   std::vector<Eigen::Vector3f> dirs_;  // dominant directions (unit normals facing the camera)
   SegmentationStats stats_;
 };
