@@ -351,16 +351,21 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   // ---- direction: do the levels rise away from the camera or towards it? ----
   int votes_up = 0, votes_down = 0;
   float prev = near_distance(nodes_[static_cast<std::size_t>(chain_[0])]);
+  trace_.near_distances.assign(1, prev);
   for (std::size_t k = 1; k < chain_.size(); ++k) {
     const float d = near_distance(nodes_[static_cast<std::size_t>(chain_[k])]);
+    trace_.near_distances.push_back(d);
     if (d > prev + kMinRise) ++votes_up;
     else if (d < prev - kMinRise) ++votes_down;
     prev = d;
   }
   const int n = static_cast<int>(chain_.size());
+  // Every pair must agree, but one may tie: a floor strip a few cm deep at the bottom of the view
+  // ends where the first riser starts, so its near boundary and the first tread's nearly coincide.
   int dir = 0;
-  if (votes_up == n - 1) dir = 1;
-  if (votes_down == n - 1) dir = -1;
+  const int need = std::max(1, n - 2);
+  if (votes_down == 0 && votes_up >= need) dir = 1;
+  if (votes_up == 0 && votes_down >= need) dir = -1;
   trace_.direction = dir;
   out.kind = StairKind::kNone;
   out.levels = n;

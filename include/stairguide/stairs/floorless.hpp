@@ -92,6 +92,7 @@ struct FloorlessTrace {
   float first_depth = 0.f;             ///< m, cold start: depth seen of that level (a floor strip deeper than a tread is the floor)
   int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
   std::vector<float> level_heights;    ///< m, up . p of each stacked level, lowest first
+  std::vector<float> near_distances;   ///< m, each stacked level's near boundary from the camera's vertical, lowest first
 };
 
 /// The floorless route. Pure: no I/O, no exceptions; buffers are kept between frames.

@@ -123,10 +123,12 @@ int detect(Context& ctx) {
       const FloorlessTrace& t = stage.floorless_trace();
       std::string heights = "[";
       for (float h : t.level_heights) heights += (heights.size() > 1 ? ", " : "") + fmt(h);
+      std::string near = "[";
+      for (float d : t.near_distances) near += (near.size() > 1 ? ", " : "") + fmt(d);
       kv("floorless", "{\"up_found\": " + std::string(t.up_found ? "true" : "false") +
                           ", \"tilt_deg\": " + fmt(rad2deg(t.tilt)) + ", \"levels\": " + fmt(t.levels) +
                           ", \"stacked\": " + fmt(t.stacked) + ", \"direction\": " + fmt(t.direction) +
-                          ", \"level_heights_m\": " + heights + "], \"first_near_cut\": " +
+                          ", \"level_heights_m\": " + heights + "], \"near_distances_m\": " + near + "], \"first_near_cut\": " +
                           (t.first_near_cut ? "true" : "false") + ", \"first_depth_m\": " + fmt(t.first_depth) + ", \"floor_level\": " +
                           (t.floor_level ? "true" : "false") + ", \"floor_seen\": " + (t.floor_seen ? "true" : "false") +
                           ", \"anchored\": " + (t.anchored ? "true" : "false") + ", \"first_index\": " +
