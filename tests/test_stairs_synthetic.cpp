@@ -228,18 +228,17 @@ TEST(StairsSynthetic, Suite) {
     }
     const double stage_recall = static_cast<double>(a.tp) / std::max(1, a.tp + a.fn - perception_fn);
     std::printf("recall where perception gave a floor and step candidates: %.4f\n", stage_recall);
-    // Measured on the whole walks (stride 3, seed 5, floorless route on): recall 0.962, fully
-    // visible 0.976 (122 of 125), 0.990 where perception gave a floor and candidates; from 1 m out
-    // 0.970 of 133 frames, within 1 m of the first edge 173 of 181 (descending 87 of 89).
-    // Descending: 118 of 120 (the 2 left are the step over the edge, where perception has no
-    // floor), every fully visible one found, none missed by the stairs stage. Issue 4's 99 % fully
-    // visible is NOT reached: the 3 misses are two cold single views whose floor strip may be a
-    // first tread (perception says "no floor"; the floorless route refuses a stack it cannot place
-    // from the feet) and one far flight whose second tread's near edge is pulled 7.7 cm towards
-    // the user by a tilted nosing strip merged into it (tread 23.3 cm: below the building code).
-    // The bounds are the measured figures less a margin, so a regression fails.
-    EXPECT_GE(a.recall(), 0.94);
-    EXPECT_GE(a.recall_fully_visible(), 0.96);
+    // Measured on the whole walks (stride 3, seed 5, floorless route on): recall 0.979 (323 of
+    // 330), fully visible 1.000 (125 of 125; issue 4 asks >= 0.99), within 1 m of the first edge
+    // 175 of 181 (descending 87 of 89). Descending: 118 of 120 (the 2 left are the step over the
+    // edge, where perception has no floor), none missed by the stairs stage. Before this round
+    // fully visible was 0.976: two cold views whose floor strip, deeper than the flight's tread,
+    // is the floor (floorless.hpp), one far flight whose second tread took in a tilted crease
+    // strip (segmentation now splits those), and after that fix a floor strip 5 cm deep at the
+    // foot of the steps that tied the direction vote. The bounds are the measured figures less a
+    // margin, so a regression fails; the fully visible one is the issue's.
+    EXPECT_GE(a.recall(), 0.96);
+    EXPECT_GE(a.recall_fully_visible(), 0.99);
     EXPECT_GE(stage_recall, 0.98);
     {
       const EvalSummary& d = s.table.by_kind.at("descending");
@@ -249,7 +248,7 @@ TEST(StairsSynthetic, Suite) {
       const auto& kb = s.kind_bins.at("descending");
       EXPECT_GE(kb[0], 82) << "descending frames detected within 1 m of the edge (measured 87 of 89)";
     }
-    EXPECT_GE(s.bin_tp[0], 165) << "frames detected within 1 m of the first edge (measured 173 of 181)";
+    EXPECT_GE(s.bin_tp[0], 168) << "frames detected within 1 m of the first edge (measured 175 of 181)";
     const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3], far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
     std::printf("recall from 1 m out: %.4f (%d frames)\n", static_cast<double>(far_tp) / std::max(1, far_tp + far_fn),
                 far_tp + far_fn);
