@@ -196,11 +196,14 @@ class Segmentation {
     int u0, v0;
     float score;
   };
-  std::vector<Cell> cells_;
+  std::vector<Cell> cells_, cells_tmp_;
+  std::vector<std::uint64_t> sort_keys_;  // sort_cells: (score bits, index) keys
+  /// Sorts cells_ by ascending score, in the very order std::sort on the cells gives (ties too).
+  void sort_cells();
   std::vector<Grow> grows_;
   struct RegionAcc {
-    double sx = 0, sy = 0, sz = 0, z3 = 0;
-    PointMoments m;
+    double z3 = 0;
+    PointMoments m;  // its first moments give the centroid
   };
   std::vector<RegionAcc> acc_;
   std::vector<PlaneFit> fits_;
@@ -211,6 +214,10 @@ class Segmentation {
   std::vector<InvDepthMoments> cell_m_;
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
+  std::vector<int> first_kept_;            // finalize: first point column at or after each column
+  std::vector<std::uint8_t> stride_keep_;  // extract_clusters: columns, then rows, that keep points
+  std::vector<int> cell_pix_;              // cell pass: one candidate's pixels in a cell, then k / cs
+  std::vector<std::uint8_t> cell_sel_;     // cell pass: best candidate of each pixel of a cell
   std::vector<int> order_, offsets_, sorted_, cid_, live_;
   std::vector<int> seams_;  // pixel pairs (p, q) on the borders between regions, from merge_regions
   std::vector<std::uint8_t> mask_;

@@ -1,4 +1,4 @@
-// `stairguide bench perception [--frames INPUT] [--count N] [--json]`: segmentation + floor +
+// `stairguide bench perception [--frames INPUT] [--count N] [--json] [--checksum]`: segmentation + floor +
 // Manhattan + classification per frame, against a reference built from PCL's own classes with the
 // paper's parameters (section 3.1: VoxelGrid 4 cm, NormalEstimation r = 5 cm, RegionGrowing
 // 6 deg / 0.5 / 50, RANSAC planarity > 80 %, EuclideanClusterExtraction), on the same frames in
@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -136,6 +137,39 @@ struct Reference {
   }
 };
 
+/// FNV-1a over raw bytes: `--checksum` hashes every region and cluster bit for bit, so that a
+/// speed change can show it leaves the output exactly as it was.
+struct Fnv {
+  std::uint64_t h = 1469598103934665603ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  }
+  template <class T>
+  void pod(const T& v) { bytes(&v, sizeof(T)); }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+std::uint64_t scene_checksum(const SceneResult& s) {
+  Fnv f;
+  f.pod(s.regions.size());
+  for (const PlaneRegion& r : s.regions) {
+    f.pod(r.id), f.pod(r.normal), f.pod(r.offset), f.pod(r.centroid), f.vec(r.points), f.vec(r.pixels);
+    f.pod(r.pixel_count), f.pod(r.area), f.pod(r.curvature), f.pod(r.rect_center), f.pod(r.rect_axis_major);
+    f.pod(r.rect_axis_minor), f.pod(r.rect_length_major), f.pod(r.rect_length_minor), f.pod(r.hull_extent);
+    f.pod(r.cls), f.pod(r.height);
+  }
+  f.pod(s.clusters.size());
+  for (const ObstacleCluster& c : s.clusters) f.vec(c.points), f.pod(c.centroid), f.pod(c.min), f.pod(c.max);
+  f.pod(s.floor_found), f.pod(s.manhattan_found);
+  f.bytes(s.T_floor_camera.matrix().data(), 16 * sizeof(float));
+  return f.h;
+}
+
 /// The inputs `--frames ARG` names (see the file comment). Throws UsageError naming the file and
 /// line when a list is unreadable or names nothing that exists.
 std::vector<std::string> frame_inputs(const std::string& arg) {
@@ -171,6 +205,7 @@ std::vector<std::string> frame_inputs(const std::string& arg) {
 
 int bench_perception(Context& ctx) {
   const bool json = ctx.flag("--json");
+  const bool checksum = ctx.flag("--checksum");
   const auto dir = ctx.option("--frames");
   const long count = ctx.int_option("--count", 1, 100000).value_or(0);
   ctx.positionals(0, 0);
@@ -216,7 +251,26 @@ int bench_perception(Context& ctx) {
   Perception ours(ctx.config);
   SceneResult scene;
   ours.process(frames[0], scene);  // warm-up: buffers reach their size
+  if (checksum) {
+    // Ours only, no timing: one hash per frame and one over all of them.
+    Fnv all;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      ours.reset();
+      ours.process(frames[i], scene);
+      const std::uint64_t h = scene_checksum(scene);
+      all.pod(h);
+      long px = 0;
+      for (const PlaneRegion& r : scene.regions) px += r.pixel_count;
+      std::printf("frame %3zu  regions %3zu  region pixels %6ld  clusters %3zu  floor %d  %016llx\n", i,
+                  scene.regions.size(), px, scene.clusters.size(), scene.floor_found ? 1 : 0,
+                  static_cast<unsigned long long>(h));
+    }
+    std::printf("checksum over %zu frames: %016llx\n", frames.size(), static_cast<unsigned long long>(all.h));
+    return 0;
+  }
+
   std::vector<double> o_wall, o_cpu, o_seg, o_floor, o_man, o_cls;
+  std::vector<double> s_cells, s_seeds, s_strips;
   std::vector<double> s_bp, s_grow, s_merge, s_refine, s_fin, s_cl, o_regions, r_regions;
   int floors = 0;
   for (const auto& f : frames) {
@@ -232,6 +286,9 @@ int bench_perception(Context& ctx) {
     const auto& st = ours.segmentation().stats();
     s_bp.push_back(st.backproject_ms);
     s_grow.push_back(st.grow_ms);
+    s_cells.push_back(st.cells_ms);
+    s_seeds.push_back(st.seeds_ms);
+    s_strips.push_back(st.strips_ms);
     s_merge.push_back(st.merge_ms);
     s_refine.push_back(st.refine_ms);
     s_fin.push_back(st.finalize_ms);
@@ -298,9 +355,10 @@ int bench_perception(Context& ctx) {
   std::printf("perception bench: %zu frames %dx%d, one thread\n", frames.size(), W, H);
   std::printf("  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d | regions median %.0f\n", med,
               p95, cmed, cp95, floors, percentile(o_regions, 0.5));
-  std::printf("    segmentation %.3f (backproject %.3f, seeds+growing %.3f, merge %.3f, borders %.3f, regions %.3f, "
-              "clusters %.3f)  floor %.3f  manhattan %.3f  classification %.3f\n",
-              percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_merge, 0.5),
+  std::printf("    segmentation %.3f (backproject %.3f, seeds+growing %.3f [cells %.3f, fine seeds %.3f, strips+splits %.3f], "
+              "merge %.3f, borders %.3f, regions %.3f, clusters %.3f)  floor %.3f  manhattan %.3f  classification %.3f\n",
+              percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_cells, 0.5),
+              percentile(s_seeds, 0.5), percentile(s_strips, 0.5), percentile(s_merge, 0.5),
               percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
               percentile(o_man, 0.5), percentile(o_cls, 0.5));
   std::printf("  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d | regions median %.0f\n", rmed,
@@ -314,7 +372,7 @@ int bench_perception(Context& ctx) {
 
 }  // namespace
 
-SG_BENCH("perception", "perception [--frames DIR|FILE|LIST.txt] [--count N] [--json]",
+SG_BENCH("perception", "perception [--frames DIR|FILE|LIST.txt] [--count N] [--json] [--checksum]",
          "segmentation+floor+Manhattan+classification vs the paper's PCL pipeline", bench_perception);
 
 }  // namespace stairguide::cli
