@@ -455,15 +455,22 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
     out.verdict = StairVerdict::kNoFirstStep;
     return;
   }
+  model_on_floor_level(scene, K, dir, out);
+}
+
+bool FloorlessStairs::model_on_floor_level(const SceneResult& scene, const CameraIntrinsics* K, int dir,
+                                           StairResult& out) {
   trace_.floor_level = true;
+  const int n = static_cast<int>(chain_.size());
   if (n - 1 < std::max(2, det_.floorless_min_levels)) {
     // A floor and one level on it: the single-level case needs the real floor (paper 4.1).
     out.detected = false;
     out.verdict = StairVerdict::kNoFloor;
     out.levels = n - 1;
-    return;
+    return false;
   }
   model(scene, K, dir, 1, nodes_[static_cast<std::size_t>(chain_[0])].height, out);
+  return true;
 }
 
 float FloorlessStairs::seen_floor_height(int dir, float riser) const {
@@ -512,14 +519,7 @@ void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrins
   trace_.first_index = k;
   if (k == 0) {
     // The floor itself is in the stack (seen, but refused by the floor detector): level 0.
-    trace_.floor_level = true;
-    if (n - 1 < std::max(2, det_.floorless_min_levels)) {
-      out.detected = false;
-      out.verdict = StairVerdict::kNoFloor;
-      out.levels = n - 1;
-      return;
-    }
-    model(scene, K, dir, 1, h0, out);
+    if (!model_on_floor_level(scene, K, dir, out)) return;
   } else {
     // Level 0 of the fit lies one riser before the first seen level: the floor when k = 1 (the
     // fit's, within the tolerance of the remembered one), the last hidden step otherwise.

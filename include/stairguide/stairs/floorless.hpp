@@ -138,6 +138,9 @@ class FloorlessStairs {
   /// comment); `level0` is the stack's fitted level 0.
   void run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser, float level0,
                     float camera_height, StairResult& out);
+  /// The first stacked level is the user's floor (level 0): models the steps above it, or refuses
+  /// (kNoFloor, false) when only one level stands on it (the single-level case needs the floor).
+  bool model_on_floor_level(const SceneResult& scene, const CameraIntrinsics* K, int dir, StairResult& out);
   /// Cold start: the camera height above a level outside the stack that can be the user's floor
   /// (a chest camera's height below, 1..1+max hidden risers from the first seen level on the
   /// user's side; the biggest such), 0 when there is none.
