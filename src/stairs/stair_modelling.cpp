@@ -273,12 +273,10 @@ bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& x
   constexpr float kEndSlack = 0.10f;   // m, a panel this near the level's lateral end bounds it
   constexpr float kPanelRise = 0.05f;  // m, a panel reaching this far above the level is furniture
   const float sin_vert = std::sin(cls_.parallel_threshold), cos_side = std::cos(cls_.parallel_threshold);
-  bool left = false, right = false;
   for (const PlaneRegion& r : scene.regions) {
     if (r.points.size() < 20 || std::fabs(r.normal.dot(up)) > sin_vert || std::fabs(r.normal.dot(xs)) < cos_side) continue;
     const float a = xs.dot(r.centroid) - a_mid;
-    const bool at_min = std::fabs(a - o.lateral_min) < kEndSlack, at_max = std::fabs(a - o.lateral_max) < kEndSlack;
-    if (!at_min && !at_max) continue;
+    if (std::fabs(a - o.lateral_min) >= kEndSlack && std::fabs(a - o.lateral_max) >= kEndSlack) continue;
     float top = -1e9f, b_lo = 1e9f, b_hi = -1e9f;
     const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 200);
     for (std::size_t i = 0; i < r.points.size(); i += stride) {
@@ -287,11 +285,9 @@ bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& x
       b_lo = std::min(b_lo, b);
       b_hi = std::max(b_hi, b);
     }
-    if (top < kPanelRise || b_hi < o.depth_min || b_lo > o.depth_max) continue;
-    left = left || at_max;
-    right = right || at_min;
+    if (top >= kPanelRise && b_hi >= o.depth_min && b_lo <= o.depth_max) return true;
   }
-  return left || right;
+  return false;
 }
 
 void StairModelling::refine_single_axis(const Level2d& L, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
