@@ -97,16 +97,24 @@ bool plane_rms_depth(const InvDepthMoments& m, float& rms_w, float& mean_z) {
   return true;
 }
 
-/// fit_plane_fixed_normal's ok and rms_w alone, by the same expressions (bit-identical).
-bool fixed_normal_rms(const InvDepthMoments& m, const Eigen::Vector3f& n, float& rms_w) {
+/// The one unknown of a plane with its normal n fixed: 1/z = g s, s = -(n . (u', v', 1)),
+/// g = 1/d. False when the moments are empty or the points would lie behind the camera on such a
+/// plane; ssw is the sum of s w the residual needs.
+bool fixed_normal_gain(const InvDepthMoments& m, const Eigen::Vector3f& n, double& g, double& ssw) {
   if (m.n < 1.0) return false;
   const double nx = n.x(), ny = n.y(), nz = n.z();
-  const double ssw = -(nx * m.suw + ny * m.svw + nz * m.sw);
+  ssw = -(nx * m.suw + ny * m.svw + nz * m.sw);
   const double sss = nx * nx * m.suu + ny * ny * m.svv + nz * nz * m.n + 2.0 * nx * ny * m.suv + 2.0 * nx * nz * m.su +
                      2.0 * ny * nz * m.sv;
   if (!(sss > 1e-30)) return false;
-  const double g = ssw / sss;
-  if (!(g > 1e-9)) return false;
+  g = ssw / sss;
+  return g > 1e-9;
+}
+
+/// fit_plane_fixed_normal's ok and rms_w alone (what the cell tests need), by the same expressions.
+bool fixed_normal_rms(const InvDepthMoments& m, const Eigen::Vector3f& n, float& rms_w) {
+  double g = 0.0, ssw = 0.0;
+  if (!fixed_normal_gain(m, n, g, ssw)) return false;
   rms_w = static_cast<float>(std::sqrt(std::max(0.0, (m.sww - g * ssw) / m.n)));
   return true;
 }
@@ -114,15 +122,9 @@ bool fixed_normal_rms(const InvDepthMoments& m, const Eigen::Vector3f& n, float&
 
 PlaneFit fit_plane_fixed_normal(const InvDepthMoments& m, const Eigen::Vector3f& n) {
   PlaneFit f;
-  if (m.n < 1.0) return f;
-  // With n fixed the plane is 1/z = g s, s = -(n . (u', v', 1)), g = 1/d: one unknown.
+  double g = 0.0, ssw = 0.0;
+  if (!fixed_normal_gain(m, n, g, ssw)) return f;
   const double nx = n.x(), ny = n.y(), nz = n.z();
-  const double ssw = -(nx * m.suw + ny * m.svw + nz * m.sw);
-  const double sss = nx * nx * m.suu + ny * ny * m.svv + nz * nz * m.n + 2.0 * nx * ny * m.suv + 2.0 * nx * nz * m.su +
-                     2.0 * ny * nz * m.sv;
-  if (!(sss > 1e-30)) return f;
-  const double g = ssw / sss;
-  if (!(g > 1e-9)) return f;  // the points would lie behind the camera on such a plane
   f.ok = true;
   f.d = static_cast<float>(1.0 / g);
   f.normal = n;
