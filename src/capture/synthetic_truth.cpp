@@ -45,6 +45,8 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
   // Per face: which tread (if any) and whether it is the surface the user stands on.
   std::vector<int> face_slot(faces.size(), -1);
   std::vector<char> face_floor(faces.size(), 0);
+  std::vector<char> face_upright(faces.size(), 0);  // walls and risers
+  std::vector<int> upright_pixels(faces.size(), 0);
   std::vector<int> slot_base(scene.stairs.size() + 1, 0);
   for (std::size_t i = 0; i < scene.stairs.size(); ++i)
     slot_base[i + 1] = slot_base[i] + scene.stairs[i].steps + 1;
@@ -54,6 +56,12 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
         fc.tread <= scene.stairs[static_cast<std::size_t>(fc.stair)].steps)
       face_slot[f] = slot_base[static_cast<std::size_t>(fc.stair)] + fc.tread;
     if (fc.normal.z() > 0.99f && std::abs(fc.vertices[0].z() - walker.support_z) < 0.01f) face_floor[f] = 1;
+    if (std::abs(fc.normal.z()) < 0.1f && fc.solid >= 0) {
+      // Walls, risers, and the front and sides of step solids (a step without a nosing is one
+      // solid whose front face is its riser).
+      const Solid& so = scene.solids()[static_cast<std::size_t>(fc.solid)];
+      face_upright[f] = so.label == "wall" || so.label == "riser" || so.stair >= 0;
+    }
   }
   // A tread pixel counts as visible only where the depth sensor gives a reading: a far tread
   // seen beyond the grazing-incidence limit, or a strip lost to mixed pixels behind a nosing,
@@ -73,10 +81,12 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
       if (f < 0 || zr[u] < o.min_range_m || zr[u] > o.max_range_m) continue;
       const int slot = face_slot[static_cast<std::size_t>(f)];
       if (slot >= 0 && !hr[u]) ++counts[static_cast<std::size_t>(slot)];
+      if (face_upright[static_cast<std::size_t>(f)] && !hr[u]) ++upright_pixels[static_cast<std::size_t>(f)];
       floor_pixels += face_floor[static_cast<std::size_t>(f)];
     }
   }
   t.floor_visible = floor_pixels * 20 >= static_cast<long>(ideal.face.total());
+  for (const int c : upright_pixels) t.wall_or_riser_pixels = std::max(t.wall_or_riser_pixels, c);
 
   const Pose T_cw = walker.T_world_camera.inverse();
   for (std::size_t i = 0; i < scene.stairs.size(); ++i) {

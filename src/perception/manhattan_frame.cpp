@@ -34,6 +34,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   float total_area = 0.f;
   struct Vote {
     float a, w, area, width;
+    float heading;  // the normal's direction in the floor plane, rad, (-pi, pi]
   };
   std::vector<Vote> votes;
   votes.reserve(regions.size());
@@ -44,7 +45,8 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     total_area += r.area;
     const Eigen::Vector3f nf = R * r.normal;
     if (std::fabs(nf.y()) > sin_tol) continue;
-    const float a = wrap_quarter(std::atan2(nf.x(), nf.z()));
+    const float heading = std::atan2(nf.x(), nf.z());
+    const float a = wrap_quarter(heading);
     // Horizontal width of the region: the spread of its points along the horizontal in its plane.
     const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
     float lo = 0.f, hi = 0.f;
@@ -60,7 +62,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     // riser is not. Votes weigh area * (width / full width)^2, the inverse of that variance.
     const float s = std::min(1.f, width / full_w);
     const float w = r.area * s * s;
-    votes.push_back({a, w, r.area, width});
+    votes.push_back({a, w, r.area, width, heading});
     int bin = static_cast<int>((a + 0.25f * kPi) / kHalfPi * kBins);
     bin = (bin % kBins + kBins) % kBins;
     // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
@@ -76,6 +78,21 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
   float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f, widest = 0.f;
+  // Two agreeing planes parallel to each other (modulo 180 degrees: two risers, two strips of one
+  // wall, a wall and a riser) are structure; two faces of one box at right angles (a person, a
+  // bin) agree modulo 90 degrees by construction and prove nothing.
+  bool parallel_pair = false;
+  std::vector<float>& headings = headings_;
+  headings.clear();
+  for (const Vote& v : votes) {
+    if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
+    for (const float h : headings) {
+      float d = std::fmod(std::fabs(v.heading - h), kPi);  // modulo 180 degrees
+      d = std::min(d, kPi - d);
+      parallel_pair = parallel_pair || d <= cfg_.cluster_tolerance;
+    }
+    headings.push_back(v.heading);
+  }
   for (const Vote& v : votes) {
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     sc += v.w * std::cos(4.f * v.a);
@@ -86,19 +103,25 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   }
   est.vertical_area = agree;
   est.fraction = total_area > 0.f ? agree / total_area : 0.f;
-  if (agree < cfg_.min_area || est.fraction < cfg_.min_points_fraction) {
+  // No share of the planar area is asked for (the paper's "Manhattan World scene" threshold):
+  // a curb's or a single step's riser 1.3 m wide is a sure frame even where the floor around it
+  // makes it 2 % of the planar area. Stair modelling asks for its own share before it trusts
+  // the frame (StairModellingConfig::manhattan_min_fraction).
+  if (agree < cfg_.min_area) {
     est.why = "too little vertical plane area for a Manhattan frame";
     return est;
   }
-  // A frame is trusted when a wide plane (a wall, a riser) supports it, or when the narrow ones
-  // agree tightly (a strip of wall at the view's edge). People, posts and the sides of boxes are
+  // A frame is trusted when a wide plane (a wall, a riser) supports it, or when narrow ones
+  // agree tightly and two of them are parallel (strips of wall at the view's edge, the risers of a
+  // flight seen in part; one narrow plane, a post or a person, agrees with itself and proves
+  // nothing). People, posts and the sides of boxes are
   // narrow and agree only to degrees: their yaw is no frame. (The spread check alone refused
   // most real kitchen views, whose walls and cupboards agree only to a few degrees; the width
   // check alone refused a corridor seen as a 35 cm strip of wall.)
   const float wsum = std::max(wsum_agree, 1e-12f);
   const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
   const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
-  if (widest < cfg_.min_plane_width && spread > cfg_.max_spread) {
+  if (widest < cfg_.min_plane_width && (!parallel_pair || spread > cfg_.max_spread || widest < 0.5f * cfg_.min_plane_width)) {
     est.why = "no wide vertical plane, and the narrow ones disagree by degrees (no wall or riser in view)";
     return est;
   }

@@ -50,6 +50,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.remembered_camera_height = 0.f;
   out.frames_since_floor = -1;
   out.manhattan_found = false;
+  out.manhattan_why.clear();
   out.T_manhattan_floor = Pose::Identity();
   out.manhattan_yaw = out.manhattan_fraction = 0.f;
   out.timings = {};
@@ -80,12 +81,14 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
     const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera);
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;
+    out.manhattan_why = m.why;
     if (m.found) {
       out.manhattan_yaw = m.yaw;
       out.T_manhattan_floor = m.T_manhattan_floor;
     }
   } else {
     out.why = "no floor: " + floor_est_.why;
+    out.manhattan_why = "no floor";
   }
   const auto t3 = Clock::now();
   out.timings.manhattan_ms = std::chrono::duration<double, std::milli>(t3 - t2).count();

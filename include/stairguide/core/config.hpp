@@ -189,7 +189,6 @@ struct FloorConfig {
 
 struct ManhattanConfig {
   float vertical_tolerance = 0.17453293f;  ///< rad, a plane counts as vertical within this (10 deg)
-  float min_points_fraction = 0.05f;       ///< share of planar area on Manhattan-aligned vertical planes
   float min_area = 0.03f;                  ///< m^2 of vertical planes needed for a Manhattan frame
   float cluster_tolerance = 0.08726646f;   ///< rad, vertical normals within this of the mode vote for it (5 deg)
   float yaw_full_width = 1.0f;   ///< m, a vertical plane's vote weighs area * min(1, width / this)^2 (its yaw's precision grows with its width)
@@ -199,8 +198,6 @@ struct ManhattanConfig {
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
           "a plane is vertical within this angle");
-    v.num(min_points_fraction, "min_points_percent", Unit::kPercent, 0, 100,
-          "share of points on vertical planes needed to call the scene Manhattan");
     v.num(min_area, "min_area_m2", Unit::kNone, 0, 100, "vertical plane area needed for a Manhattan frame, square metres");
     v.num(cluster_tolerance, "cluster_tolerance_deg", Unit::kDegree, 0.5, 44,
           "vertical normals within this of the dominant direction (mod 90 deg) refine it");

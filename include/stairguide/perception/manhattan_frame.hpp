@@ -4,8 +4,8 @@
 /// the two orthogonal horizontal directions that the vertical planes' normals agree with most
 /// (vote modulo 90 degrees weighted by area * (width / yaw_full_width)^2, the precision of a plane's
 /// yaw, refined by a circular mean of the votes near the peak; no frame when no agreeing plane is
-/// min_plane_width wide and the agreeing votes spread more than max_spread, e.g. only people and
-/// posts in view).
+/// min_plane_width wide and the agreeing votes spread more than max_spread or hold no two
+/// parallel planes, e.g. only people and posts in view).
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -42,6 +42,7 @@ class ManhattanTracker {
  private:
   ManhattanConfig cfg_;
   std::optional<float> prev_yaw_;
+  std::vector<float> headings_;  // scratch: agreeing planes' headings
 };
 
 }  // namespace stairguide

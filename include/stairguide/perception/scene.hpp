@@ -83,6 +83,7 @@ struct SceneResult {
   int frames_since_floor = -1;            ///< frames since the floor was last found; -1 never (or forgotten)
 
   bool manhattan_found = false;
+  std::string manhattan_why;              ///< why no Manhattan frame (when !manhattan_found)
   Pose T_manhattan_floor = Pose::Identity();  ///< floor frame into Manhattan frame M (rotation about y)
   float manhattan_yaw = 0.f;              ///< rad, angle of k_M from z_F about y_F
   float manhattan_fraction = 0.f;         ///< share of points on Manhattan-aligned vertical planes
