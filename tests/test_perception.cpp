@@ -466,6 +466,20 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
         std::printf("  %s #%llu: no Manhattan frame, a wall or riser of %d px in view (%s)\n", preset.c_str(),
                     static_cast<unsigned long long>(truth->index), truth->wall_or_riser_pixels,
                     sc.manhattan_why.c_str());
+      if (getenv("SG_DEBUG_MANHATTAN") && sc.floor_found && !(yaw_err >= 0.f && yaw_err <= 2.f)) {
+        // The vertical regions: size, depth, and yaw error against the truth (what voted).
+        for (const PlaneRegion& R : sc.regions) {
+          const Eigen::Vector3f nw = Rwc * R.normal;
+          if (std::fabs(nw.z()) > std::sin(10 * kDeg)) continue;
+          float e = std::fabs(wrap45(std::atan2(nw.y(), nw.x())));
+          for (const StairTruth& st : truth->stairs) {
+            const Eigen::Vector3f zs = Rwc * st.T_camera_stair.linear().col(2);
+            e = std::min(e, std::fabs(wrap45(std::atan2(nw.y(), nw.x()) - std::atan2(zs.y(), zs.x()))));
+          }
+          std::printf("    vertical: %d px area %.3f m2 %.2f x %.2f m at %.2f m, yaw off %.2f deg\n", R.pixel_count,
+                      R.area, R.rect_length_major, R.rect_length_minor, R.centroid.z(), e / kDeg);
+        }
+      }
     }
     if (yaw_err >= 0.f && (wall_or_riser || truth->any_stair_visible())) {
       F.worst_yaw = std::max(F.worst_yaw, yaw_err);
