@@ -747,6 +747,171 @@ void Segmentation::split_border_bands(std::vector<Grow>& grows) {
   }
 }
 
+void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
+  // The same sliver as split_border_bands, below an occlusion edge instead of the image border:
+  // the visible part of a far tread between its riser (below in the image) and the shadow of the
+  // next nosing (no readings above it) is a few rows per column, each pixel within the noise of
+  // the riser's plane, and the riser's region takes it. Only the top pixels of the columns of a
+  // riser-like region that end under a hole can be such a sliver; the holes are found on the cell
+  // grid (cells short of readings), so only their pixels are read.
+  if (dirs_.size() < 2 || CW_ == 0 || cell_valid_.empty()) return;
+  const int K = kBorderBandRows;
+  const int cs = std::max(2, cfg_.cell_size_px);
+  const int n = static_cast<int>(grows.size());
+  const float cos_own = std::cos(cfg_.region_angle);
+  // A tread and its riser meet at 90 degrees (give or take the build and the fits' noise).
+  const float sin_cross = std::sin(15.f * 3.14159265f / 180.f);
+  const float limit = 0.5f * tolerance_w();
+  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
+  const int nd = static_cast<int>(dirs_.size());
+  // Candidate regions: planar, parallel to a dominant direction (a riser, the front of a nosing)
+  // and square to another one (the treads).
+  std::vector<int>& slot = cid_;
+  slot.assign(static_cast<std::size_t>(n), -1);
+  std::vector<int>& regs = live_;
+  regs.clear();
+  for (int r = 0; r < n; ++r) {
+    const Grow& g = grows[r];
+    if (g.count < cfg_.region_min_pixels + static_cast<int>(kSplitMinSide) || !g.plane.ok || g.plane.rms_w > limit)
+      continue;
+    bool on_dir = false, square = false;
+    for (const Eigen::Vector3f& d : dirs_) {
+      const float c = std::fabs(d.dot(g.plane.normal));
+      on_dir |= c > cos_own;
+      square |= c < sin_cross;
+    }
+    if (!on_dir || !square) continue;
+    slot[r] = static_cast<int>(regs.size());
+    regs.push_back(r);
+  }
+  if (regs.empty()) return;
+  // Tops of columns under a hole, in the cells at an occlusion edge: cells short of readings by
+  // two rows' worth, or below such a cell, with readings of their own. A top is a pixel of a
+  // candidate whose two upper neighbours have no reading. Per candidate and row below the edge
+  // (band bins), the residuals under the candidate's plane are summed first (cheap, in floats):
+  // a sliver of a tread lies behind the riser's plane (a convex edge) by many sigma^2 in all.
+  const int holey = cs * cs - 2 * cs;
+  std::vector<int>& tops = order_;
+  tops.clear();
+  std::vector<float>& acc = edge_acc_;  // per candidate and bin: count, sum and sum of squares of residuals
+  acc.assign(regs.size() * static_cast<std::size_t>(3 * K), 0.f);
+  auto edge_top = [&](int p) {
+    const int l = label_[p];
+    if (l < 0 || slot[l] < 0) return;
+    tops.push_back(p);
+    const int v = row_of(p), u = p - v * W_;
+    const PlaneFit& f = grows[l].plane;
+    float* a = &acc[static_cast<std::size_t>(slot[l]) * 3 * K];
+    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) {
+      const float res = w_[p + k * W_] - (f.a * un_[u] + f.b * vn_[v + k] + f.c);
+      a[3 * k] += 1.f, a[3 * k + 1] += res, a[3 * k + 2] += res * res;
+    }
+  };
+  for (int cv = 0; cv < CH_; ++cv)
+    for (int cu = 0; cu < CW_; ++cu) {
+      const int c = cv * CW_ + cu;
+      const int nv = cell_valid_[static_cast<std::size_t>(c)];
+      if (nv < cs || (nv > holey && (cv == 0 || cell_valid_[static_cast<std::size_t>(c - CW_)] > holey))) continue;
+      const int u0 = cu * cs;
+      // A top two rows or more down the cell has two of the cell's own pixels without a reading
+      // above it; one in the first two rows has holes in the bottom rows of the cell above.
+      const int v_first = cv > 0 && cell_valid_[static_cast<std::size_t>(c - CW_)] == cs * cs ? cv * cs + 2 : cv * cs;
+      const int v_end = nv >= cs * cs - 1 ? cv * cs + 2 : (cv + 1) * cs;
+      for (int v = std::max(2, v_first); v < v_end; ++v) {
+        const int row = v * W_;
+        // Columns of this row with a reading under two rows without: four at a time where the
+        // cell allows (the holes make a branch per pixel mispredict; this test was most of the
+        // pass's time).
+        int i = 0;
+#if defined(__SSE2__)
+        const __m128 zero = _mm_setzero_ps();
+        for (; i + 4 <= cs; i += 4) {
+          const float* z0 = &z_[static_cast<std::size_t>(row + u0 + i)];
+          const __m128 top = _mm_cmpgt_ps(_mm_loadu_ps(z0), zero);
+          const __m128 above = _mm_or_ps(_mm_cmpgt_ps(_mm_loadu_ps(z0 - W_), zero), _mm_cmpgt_ps(_mm_loadu_ps(z0 - 2 * W_), zero));
+          int mask = _mm_movemask_ps(_mm_andnot_ps(above, top));
+          while (mask) {
+            const int j = __builtin_ctz(static_cast<unsigned>(mask));
+            mask &= mask - 1;
+            edge_top(row + u0 + i + j);
+          }
+        }
+#endif
+        for (; i < cs; ++i) {
+          const int p = row + u0 + i;
+          if (z_[p] > 0.f && !(z_[p - W_] > 0.f) && !(z_[p - 2 * W_] > 0.f)) edge_top(p);
+        }
+      }
+    }
+  if (tops.empty()) return;
+  // Candidates whose band, for some depth, holds enough pixels, lies behind the plane and is off
+  // it by half the gain a split needs (the rest of the gain can come from the rest's refit).
+  bool any = false;
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const float* a = &acc[i * 3 * K];
+    float cnt = 0.f, sr = 0.f, srr = 0.f;
+    bool pass = false;
+    for (int k = 0; k < K; ++k) {
+      cnt += a[3 * k], sr += a[3 * k + 1], srr += a[3 * k + 2];
+      pass |= cnt >= cfg_.region_min_pixels && sr < 0.f && srr >= 0.5 * kSplitGain * sig2;
+    }
+    if (a[0] < kSplitMinSide || !pass) slot[regs[i]] = -1;
+    any |= slot[regs[i]] >= 0;
+  }
+  if (!any) return;
+  bins_.assign(regs.size() * static_cast<std::size_t>(K), InvDepthMoments{});
+  for (int p : tops) {
+    const int l = label_[p];
+    if (slot[l] < 0) continue;
+    const int v = row_of(p), u = p - v * W_;
+    InvDepthMoments* b = &bins_[static_cast<std::size_t>(slot[l]) * K];
+    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) b[k].add(un_[u], vn_[v + k], w_[p + k * W_]);
+  }
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const int r = regs[i];
+    if (slot[r] < 0) continue;
+    const Grow& g = grows[r];
+    const double ssr_joint = g.m.n * InvDepthMomentsMsr(g.m, g.plane.a, g.plane.b, g.plane.c);
+    double best = ssr_joint;
+    int best_k = 0, best_d = -1;
+    InvDepthMoments band;
+    for (int k = 1; k <= K; ++k) {
+      band.add(bins_[i * K + static_cast<std::size_t>(k - 1)]);
+      if (band.n < cfg_.region_min_pixels || !(band.mean_residual(g.plane.a, g.plane.b, g.plane.c) < 0.0)) continue;
+      const InvDepthMoments rest = moments_minus(g.m, band);
+      if (rest.n < cfg_.region_min_pixels) break;
+      // What stays must still be one plane within the noise.
+      const PlaneFit fr = fit_plane(rest);
+      if (!fr.ok || fr.rms_w > limit) continue;
+      for (int d = 0; d < nd; ++d) {
+        if (std::fabs(dirs_[d].dot(g.plane.normal)) > sin_cross) continue;
+        // The sliver lies on that direction within the noise (a bent surface, a person, does not).
+        const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
+        if (!fb.ok || fb.rms_w > limit) continue;
+        // A convex edge, as a tread's over its riser: each side lies beyond the other's plane
+        // (1/z below it; the band's side was checked above). At a concave one (a floor meeting a
+        // wall, a seat meeting its back) each lies in front of the other's: no tread there.
+        if (!(rest.mean_residual(fb.a, fb.b, fb.c) < 0.0)) continue;
+        const double ssr = fit_ssr(fb, band) + fit_ssr(fr, rest);
+        if (ssr < best) best = ssr, best_k = k, best_d = d;
+      }
+    }
+    if (best_d < 0 || ssr_joint - best < kSplitGain * sig2) continue;
+    std::vector<int>& pix = split_pixels_;
+    pix.clear();
+    for (int p : tops) {
+      const int v = row_of(p);
+      for (int k = 0; k < best_k && v + k < H_ && label_[p + k * W_] == r; ++k) pix.push_back(p + k * W_);
+    }
+    if (!move_to_new_region(grows, r, pix, best_d)) continue;
+    Grow& gr = grows[r];
+    int dir = gr.dir;
+    const PlaneFit f = region_plane(gr.m, dir);
+    if (f.ok) gr.plane = f, gr.dir = dir;
+    ++stats_.edge_splits;
+  }
+}
+
 void Segmentation::sort_cells() {
   // Seeds in ascending score, sorted as 64-bit keys (the score's bits made monotonic as an
   // unsigned integer: negatives flipped, positives with the sign bit set; then the index) instead
@@ -786,6 +951,7 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
   cell_m_.assign(static_cast<std::size_t>(nc), InvDepthMoments{});
   cell_label_.assign(static_cast<std::size_t>(nc), -1);
   cell_planar_.assign(static_cast<std::size_t>(nc), 0);
+  cell_valid_.assign(static_cast<std::size_t>(nc), 0);
   cells_.clear();
   const int need = (cs * cs * 4) / 5;
   const float limit = 0.5f * tolerance_w();
@@ -897,8 +1063,10 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
         _mm_store_ps(asuw, Suw);
         _mm_store_ps(asvw, Svw);
         _mm_store_ps(asww, Sww);
-        for (int k = 0; k < 4; ++k)
+        for (int k = 0; k < 4; ++k) {
+          cell_valid_[static_cast<std::size_t>(cv * CW_ + cu + k)] = static_cast<std::uint16_t>(an[k]);
           if (w0s[k] != 0.f) finish(cu + k, cv, w0s[k], an[k], asw[k], asuw[k], asvw[k], asww[k]);
+        }
       }
     }
 #endif
@@ -921,6 +1089,7 @@ void Segmentation::cell_pass(std::vector<Grow>& grows) {
           Sww += dw * dw;
         }
       }
+      cell_valid_[static_cast<std::size_t>(cv * CW_ + cu)] = static_cast<std::uint16_t>(n);
       finish(cu, cv, w0, n, Sw, Suw, Svw, Sww);
     }
   }
@@ -1764,6 +1933,7 @@ bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions
   strip_pass(grows_);
   split_creases(grows_);
   split_border_bands(grows_);
+  split_edge_bands(grows_);
   stats_.strips_ms = lap();
   stats_.grow_ms = stats_.cells_ms + stats_.seeds_ms + stats_.strips_ms;
   merge_regions(grows_);

@@ -23,7 +23,12 @@
 ///     across a tread/riser crease at range, planar within the noise) is split along the crease
 ///     line of the two; a band of up to a few rows at the top border of the view that lies on
 ///     another dominant direction than the rest of its region (a tread sliver taken by its riser)
-///     is split off. Both only where the split lowers the summed squared residual by many sigma^2;
+///     is split off, and so is a band of up to a few rows below an occlusion edge (a tread's
+///     visible part under the shadow of the next nosing, taken by its riser): found from the cells
+///     short of readings, on regions parallel to one dominant direction and square to another,
+///     only where the band lies behind the region's plane by many sigma^2 (a convex edge; a floor
+///     meeting a wall is concave) and on a dominant direction within the noise. All three only
+///     where the split lowers the summed squared residual by many sigma^2;
 ///  5. adjacent regions on one plane are merged (each part's mean residual under the union's
 ///     plane within the noise: a small part's own tilt is too rough to extrapolate over a big
 ///     neighbour); small regions that bend smoothly (no depth jump, normals between the merge
@@ -117,6 +122,7 @@ struct SegmentationStats {
   int curved_tiles = 0;  ///< small regions dropped as facets of a curved surface
   int crease_splits = 0;  ///< regions split along a crease between two dominant directions
   int border_splits = 0;  ///< bands at the top border split off their region
+  int edge_splits = 0;    ///< bands below an occlusion edge split off their region
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -161,6 +167,9 @@ class Segmentation {
   /// Splits off a band of rows at the top border of the view that lies on another dominant
   /// direction than the rest of its region (a tread sliver above its riser).
   void split_border_bands(std::vector<Grow>& grows);
+  /// The same below an occlusion edge (no readings above): a tread's visible sliver between its
+  /// riser and the shadow of the next nosing, taken by the riser's region.
+  void split_edge_bands(std::vector<Grow>& grows);
   /// Moves the pixels of region `r` listed in `pixels` to a new region on direction `dir`.
   /// Returns false (nothing changed) when the new region's fit fails.
   bool move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir);
@@ -214,6 +223,7 @@ class Segmentation {
   std::vector<InvDepthMoments> cell_m_;
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
+  std::vector<std::uint16_t> cell_valid_;  // cell pass: pixels with a reading per cell
   std::vector<int> first_kept_;            // finalize: first point column at or after each column
   std::vector<std::uint8_t> stride_keep_;  // extract_clusters: columns, then rows, that keep points
   std::vector<int> cell_pix_;              // cell pass: one candidate's pixels in a cell, then k / cs
@@ -225,6 +235,7 @@ class Segmentation {
   int released_ = 0;                 // pixels (queue_[0..n)) released by the last dropped grow_region
   std::vector<std::uint16_t> contact_, smooth_;
   std::vector<float> area_;
+  std::vector<float> edge_acc_;  // split_edge_bands: residual sums per candidate region and band row
   std::vector<Eigen::Vector3f> big_dirs_;  // region pairs: seam samples, depth-continuous ones
   std::vector<InvDepthMoments> bins_;  // split passes: moments per sweep bin / row
   std::vector<int> split_pixels_, split_side_;
