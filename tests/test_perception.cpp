@@ -655,20 +655,22 @@ class TotalsCheck : public ::testing::Environment {
     // tread pixels the sensor gives no depth for (grazing incidence, mixed pixels behind nosings).
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 502/502)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
-    // or riser (>= 200 px) in view. Measured 209/241 static views, 32/40 walking; no frame is
-    // ever more than 2 deg off with a staircase in view. The misses:
+    // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
+    // 199/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // in view. The misses:
     //  - a rotated sofa, shelf or bench fills the view and the wall behind it shows in a strip
-    //    (570-6600 px): the frame follows the furniture (13 views; the synthetic world turns
-    //    furniture freely against the walls);
-    //  - walls and risers too small or too thin to make a plane: open risers' 4 cm slab fronts,
-    //    a 450 px strip of wall while turning (16 views);
-    //  - no floor found although it is in view (3 views).
+    //    (530-6600 px): the frame follows the furniture (13 views; the synthetic world turns
+    //    furniture freely against the walls; voting without free-standing planes first won 4 of
+    //    them but turned the real kitchen's frames by up to 3.7 deg, so it is not done);
+    //  - walls and risers seen too small or narrow to make a trusted plane (10 views), and a
+    //    450 px strip of wall while turning (8 walking views);
+    //  - no floor found although it is in view (4 views).
     // (Counted before only on views reporting a frame: 143/143. The 5 % share of planar area the
     // paper asks of a "Manhattan scene" refused risers of curbs and single steps 1.3 m wide; it
     // is gone, and one narrow plane, or two faces of one box, no longer make a frame.)
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 207) << "Manhattan frame within 2 deg where a wall or riser is in view (209/241)";
+    EXPECT_GE(A.manhattan_ok, 197) << "Manhattan frame within 2 deg where a wall or riser is in view (199/226)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
   }
 };

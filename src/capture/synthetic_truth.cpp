@@ -10,6 +10,7 @@ namespace {
 
 constexpr int kMinTreadPixels = 200;
 constexpr float kEdgeSpacing = 0.02f;  // m between samples of the first edge
+constexpr float kMinRiserHeight = 0.08f;  // m, a wall or riser face at least this tall (wall_or_riser_pixels)
 
 // True when the point (camera frame) is seen: it projects into the image and a pixel of its 3x3
 // neighbourhood has a rendered depth close to the point's (no occluder in front of it).
@@ -58,9 +59,12 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
     if (fc.normal.z() > 0.99f && std::abs(fc.vertices[0].z() - walker.support_z) < 0.01f) face_floor[f] = 1;
     if (std::abs(fc.normal.z()) < 0.1f && fc.solid >= 0) {
       // Walls, risers, and the front and sides of step solids (a step without a nosing is one
-      // solid whose front face is its riser).
+      // solid whose front face is its riser), at least kMinRiserHeight tall: the 4 cm front edge
+      // of an open riser's tread slab is no riser.
       const Solid& so = scene.solids()[static_cast<std::size_t>(fc.solid)];
-      face_upright[f] = so.label == "wall" || so.label == "riser" || so.stair >= 0;
+      float z_lo = fc.vertices.front().z(), z_hi = z_lo;
+      for (const Eigen::Vector3f& q : fc.vertices) z_lo = std::min(z_lo, q.z()), z_hi = std::max(z_hi, q.z());
+      face_upright[f] = (so.label == "wall" || so.label == "riser" || so.stair >= 0) && z_hi - z_lo >= kMinRiserHeight;
     }
   }
   // A tread pixel counts as visible only where the depth sensor gives a reading: a far tread

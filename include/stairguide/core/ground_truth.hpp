@@ -60,8 +60,8 @@ struct FrameTruth {
   bool floor_visible = false;       ///< >= 5% of pixels see the floor the user stands on
   std::vector<StairTruth> stairs;   ///< staircases in the scene (visible or not)
   /// Pixels of the most visible wall or riser face (a vertical face of a wall, a riser or a step,
-  /// within range, where the depth sensor gives a reading): what the Manhattan frame is built
-  /// from. 0 for dataset frames.
+  /// at least 8 cm tall, within range, where the depth sensor gives a reading): what the
+  /// Manhattan frame is built from. 0 for dataset frames.
   int wall_or_riser_pixels = 0;
 
   /// Staircases with at least one visible step or a visible first edge.
