@@ -684,7 +684,10 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
   for (const auto& p : synth::presets())
     if (p.name == preset && p.default_frames > 1) length = p.default_frames, frames = 32;
   PresetFigures F;
-  run_preset(preset, frames, 20261123u, length, F);
+  // SG_SEED=N runs the presets on another seed (the bounds below hold for the default one):
+  // measured Manhattan 208/236 on seed 7 and 221/250 on seed 8, no frame off with stairs in view.
+  const char* seed = getenv("SG_SEED");
+  run_preset(preset, frames, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, length, F);
   (length <= 1 ? Totals::get() : Totals::sequences()).add(F);
   print(preset, F);
   ASSERT_GT(F.frames, 0);
