@@ -74,6 +74,8 @@ int analyze(Context& ctx) {
     if (scene.manhattan_found)
       std::printf(", \"manhattan_yaw_deg\": %.3f, \"manhattan_fraction\": %.3f", rad2deg(scene.manhattan_yaw),
                   scene.manhattan_fraction);
+    else
+      std::printf(", \"manhattan_why\": \"%s\"", json_escape(scene.manhattan_why).c_str());
     std::printf(", \"regions\": [");
     for (std::size_t i = 0; i < scene.regions.size(); ++i) {
       const PlaneRegion& r = scene.regions[i];
@@ -101,7 +103,7 @@ int analyze(Context& ctx) {
       std::printf("manhattan: yaw %.2f deg (%.0f%% of plane area on aligned vertical planes)\n",
                   rad2deg(scene.manhattan_yaw), 100.f * scene.manhattan_fraction);
     else
-      std::printf("manhattan: not found\n");
+      std::printf("manhattan: not found (%s)\n", scene.manhattan_why.c_str());
     std::printf("%zu regions, %zu obstacle clusters\n", scene.regions.size(), scene.clusters.size());
     std::printf("  %3s %-15s %-26s %9s %8s %8s %13s\n", "id", "class", scene.floor_found ? "normal (floor frame)" : "normal (camera)",
                 "height m", "pixels", "area m2", "size m");
