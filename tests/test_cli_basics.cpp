@@ -1,34 +1,17 @@
 // The stairguide binary: check-config, --config on every command, synth --list and a small synth.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "cli_test_util.hpp"
+
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun run(const std::string& args) {
-  CliRun r;
-  const std::string cmd = std::string(STAIRGUIDE_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string tmp(const std::string& name) { return std::string(STAIRGUIDE_BINARY_DIR) + "/test_cli_" + name; }
+using cli_test::CliRun;
+using cli_test::run;
+std::string tmp(const std::string& name) { return cli_test::tmp("test_cli_", name); }
 
 }  // namespace
 
