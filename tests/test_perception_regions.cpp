@@ -1,0 +1,156 @@
+// Perception (paper 3.1 and 3.3) on a scene built for the purpose, with known sizes: what each
+// planar region carries (plane, centroid, points and pixels, area, rectangle in its own axes,
+// concave-hull extent, curvature) and what it is classified as (floor, step candidate, obstacle;
+// vertical left, right, front), and a curved pole left to the obstacle clusters.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_builders.hpp"
+#include "stairguide/capture/synthetic_render.hpp"
+#include "stairguide/perception/perception.hpp"
+
+using namespace stairguide;
+using namespace stairguide::synth;
+
+namespace {
+
+constexpr float kCamHeight = 1.40f;
+
+// World: z up, the user at the origin looking along +y, a chest camera tilted 45 degrees down.
+Pose chest_camera(float tilt_deg) {
+  const float t = tilt_deg * 3.14159265f / 180.f;
+  Eigen::Matrix3f R;
+  R.col(0) = Eigen::Vector3f(1.f, 0.f, 0.f);                           // x right
+  R.col(2) = Eigen::Vector3f(0.f, std::cos(t), -std::sin(t));          // z forward, down
+  R.col(1) = R.col(2).cross(R.col(0));                                  // y down
+  Pose T = Pose::Identity();
+  T.linear() = R;
+  T.translation() = Eigen::Vector3f(0.f, 0.f, kCamHeight);
+  return T;
+}
+
+struct Built {
+  RgbdFrame frame;
+  Pose T_world_camera;
+};
+
+// A room 3.1 m wide with a 16 cm platform (1.0 x 0.5 m) ahead, a 7 cm block to the right, and a
+// pole (10 cm radius) to the left.
+Built build() {
+  Scene scene;
+  scene.name = "regions";
+  Rng rng(11);
+  scene.add_box_world({-1.5f, -1.f, -0.1f}, {1.6f, 4.5f, 0.f}, floor_material(rng), "floor");
+  scene.add_box_world({-1.6f, -1.f, 0.f}, {-1.5f, 4.5f, 2.5f}, wall_material(rng), "wall");  // left
+  scene.add_box_world({1.6f, -1.f, 0.f}, {1.7f, 4.5f, 2.5f}, wall_material(rng), "wall");    // right
+  scene.add_box_world({-1.6f, 4.0f, 0.f}, {1.7f, 4.1f, 2.5f}, wall_material(rng), "wall");   // ahead
+  scene.add_box_world({-0.5f, 1.6f, 0.f}, {0.5f, 2.1f, 0.16f}, wood_material(rng), "platform");
+  scene.add_box_world({0.6f, 0.9f, 0.f}, {1.0f, 1.2f, 0.07f}, wood_material(rng), "block");
+  // Rendered as a prism: with 64 sides each facet is 1 cm wide, a curved surface to the sensor.
+  scene.add_cylinder({-0.8f, 1.4f, 0.f}, {-0.8f, 1.4f, 1.0f}, 0.1f, 0.1f, metal_material(rng), "pole", 64);
+  Built b;
+  b.T_world_camera = chest_camera(45.f);
+  const SynthOptions o;
+  const CameraIntrinsics K = synthetic_intrinsics(o);
+  RenderBuffers ideal;
+  render(scene, b.T_world_camera, K, ideal, false);
+  apply_depth_sensor(ideal, K, o, 7, b.frame.depth);
+  b.frame.intrinsics = K;
+  return b;
+}
+
+// The region whose centroid lies nearest `p_world` among those with a normal within 10 degrees
+// of `n_world`; -1 when none.
+int find_region(const SceneResult& sc, const Pose& T_wc, const Eigen::Vector3f& p_world,
+                const Eigen::Vector3f& n_world, float max_dist) {
+  int best = -1;
+  float best_d = max_dist;
+  for (int i = 0; i < static_cast<int>(sc.regions.size()); ++i) {
+    const PlaneRegion& R = sc.regions[static_cast<std::size_t>(i)];
+    if (std::fabs((T_wc.linear() * R.normal).dot(n_world)) < std::cos(0.1745f)) continue;
+    const float d = (T_wc * R.centroid - p_world).norm();
+    if (d < best_d) best_d = d, best = i;
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST(PerceptionRegions, GeometryAndClassesOnAKnownScene) {
+  const Built b = build();
+  Perception P;
+  SceneResult sc;
+  P.process(b.frame, sc);
+  ASSERT_TRUE(sc.floor_found) << sc.why;
+  EXPECT_NEAR(sc.camera_height, kCamHeight, 0.02f);
+  EXPECT_NEAR(sc.camera_tilt * 180.f / 3.14159265f, 45.f, 1.f);
+  ASSERT_TRUE(sc.manhattan_found) << sc.manhattan_why;
+  const Pose& T = b.T_world_camera;
+  const Eigen::Vector3f up(0.f, 0.f, 1.f), x(1.f, 0.f, 0.f), y(0.f, 1.f, 0.f);
+
+  // Every region: a unit normal facing the camera, its points on its plane, pixels and count.
+  for (const PlaneRegion& R : sc.regions) {
+    EXPECT_NEAR(R.normal.norm(), 1.f, 1e-4f);
+    EXPECT_LT(R.normal.dot(R.centroid), 0.f) << "normal facing away from the camera";
+    EXPECT_EQ(R.pixel_count, static_cast<int>(R.pixels.size()));
+    ASSERT_FALSE(R.points.empty());
+    EXPECT_NEAR(R.normal.dot(R.centroid) + R.offset, 0.f, 0.01f);
+  }
+
+  // The floor.
+  ASSERT_GE(sc.floor_region, 0);
+  EXPECT_EQ(sc.regions[static_cast<std::size_t>(sc.floor_region)].cls, RegionClass::kFloor);
+
+  // The platform's top, 1.0 x 0.5 m at 16 cm, seen whole: a step candidate with its size.
+  const int top = find_region(sc, T, {0.f, 1.85f, 0.16f}, up, 0.1f);
+  ASSERT_GE(top, 0) << "platform top not found";
+  const PlaneRegion& P1 = sc.regions[static_cast<std::size_t>(top)];
+  EXPECT_EQ(P1.cls, RegionClass::kStepCandidate);
+  EXPECT_NEAR(P1.height, 0.16f, 0.01f);
+  EXPECT_NEAR(P1.rect_length_major, 1.0f, 0.05f);
+  EXPECT_NEAR(P1.rect_length_minor, 0.5f, 0.05f);
+  EXPECT_NEAR(P1.area, 0.5f, 0.06f);
+  EXPECT_GT(P1.hull_extent, 0.85f) << "a rectangle fills its bounding rectangle";
+  EXPECT_LT(P1.curvature, 0.01f);
+  EXPECT_LT((T * P1.centroid - Eigen::Vector3f(0.f, 1.85f, 0.16f)).norm(), 0.03f);
+  EXPECT_GT((T.linear() * P1.rect_axis_major).cwiseAbs().x(), 0.98f) << "major axis along the platform's 1 m side";
+
+  // Its front face, facing the user: vertical front.
+  const int front = find_region(sc, T, {0.f, 1.6f, 0.08f}, y, 0.1f);
+  ASSERT_GE(front, 0) << "platform front not found";
+  EXPECT_EQ(sc.regions[static_cast<std::size_t>(front)].cls, RegionClass::kVerticalFront);
+
+  // The block's top at 7 cm: horizontal, above the floor but below a step's height (H_min): an
+  // obstacle to trip on.
+  const int block = find_region(sc, T, {0.8f, 1.05f, 0.07f}, up, 0.1f);
+  ASSERT_GE(block, 0) << "block top not found";
+  EXPECT_EQ(sc.regions[static_cast<std::size_t>(block)].cls, RegionClass::kObstacle);
+  EXPECT_NEAR(sc.regions[static_cast<std::size_t>(block)].height, 0.07f, 0.01f);
+
+  // The side walls: the one on the user's left is vertical left, the other vertical right.
+  int left = 0, right = 0, wrong = 0;
+  for (const PlaneRegion& R : sc.regions) {
+    const Eigen::Vector3f n = T.linear() * R.normal, c = T * R.centroid;
+    if (std::fabs(n.dot(x)) < std::cos(0.1745f) || R.pixel_count < 500) continue;
+    if (std::fabs(c.x() + 1.5f) < 0.05f) (R.cls == RegionClass::kVerticalLeft ? left : wrong)++;
+    if (std::fabs(c.x() - 1.6f) < 0.05f) (R.cls == RegionClass::kVerticalRight ? right : wrong)++;
+  }
+  EXPECT_GE(left, 1) << "left wall";
+  EXPECT_GE(right, 1) << "right wall";
+  EXPECT_EQ(wrong, 0) << "a side wall classified the other way";
+
+  // The pole is curved: no planar region stands on it, and an obstacle cluster does.
+  for (const PlaneRegion& R : sc.regions) {
+    const Eigen::Vector3f c = T * R.centroid;
+    EXPECT_FALSE(std::hypot(c.x() + 0.8f, c.y() - 1.4f) < 0.12f && c.z() > 0.05f && R.pixel_count > 300)
+        << "a plane of " << R.pixel_count << " px on the pole";
+  }
+  bool pole_cluster = false;
+  for (const ObstacleCluster& C : sc.clusters) {
+    const Eigen::Vector3f c = T * C.centroid;
+    pole_cluster = pole_cluster || std::hypot(c.x() + 0.8f, c.y() - 1.4f) < 0.2f;
+  }
+  EXPECT_TRUE(pole_cluster) << "the pole is an obstacle cluster";
+}
