@@ -656,21 +656,21 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 502/502)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 199/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 208/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
-    //  - a rotated sofa, shelf or bench fills the view and the wall behind it shows in a strip
-    //    (530-6600 px): the frame follows the furniture (13 views; the synthetic world turns
-    //    furniture freely against the walls; voting without free-standing planes first won 4 of
-    //    them but turned the real kitchen's frames by up to 3.7 deg, so it is not done);
-    //  - walls and risers seen too small or narrow to make a trusted plane (10 views), and a
-    //    450 px strip of wall while turning (8 walking views);
+    //  - walls and risers seen too small or narrow to trust (9 views), and a 450 px strip of wall
+    //    while turning (8 walking views);
+    //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
+    //    shows only as a strip too narrow or too far to make a frame of its own (5 views);
     //  - no floor found although it is in view (4 views).
-    // (Counted before only on views reporting a frame: 143/143. The 5 % share of planar area the
-    // paper asks of a "Manhattan scene" refused risers of curbs and single steps 1.3 m wide; it
-    // is gone, and one narrow plane, or two faces of one box, no longer make a frame.)
+    // History: counted only on views reporting a frame, 143/143. On every view: 209/241 once the
+    // paper's 5 % share of planar area (it refused curbs' and single steps' risers 1.3 m wide) was
+    // dropped and one narrow plane, or two faces of one box, no longer made a frame; 199/226 once
+    // an open riser's tread edge no longer counted as a riser; 208/226 once planes with floor
+    // beyond them (furniture, risers, people) voted only when the walls make no frame.
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 197) << "Manhattan frame within 2 deg where a wall or riser is in view (199/226)";
+    EXPECT_GE(A.manhattan_ok, 206) << "Manhattan frame within 2 deg where a wall or riser is in view (208/226)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
   }
 };
@@ -685,7 +685,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     if (p.name == preset && p.default_frames > 1) length = p.default_frames, frames = 32;
   PresetFigures F;
   // SG_SEED=N runs the presets on another seed (the bounds below hold for the default one):
-  // measured Manhattan 208/236 on seed 7 and 221/250 on seed 8, no frame off with stairs in view.
+  // measured Manhattan 213/236 on seed 7 and 230/250 on seed 8, no frame off with stairs in view.
   const char* seed = getenv("SG_SEED");
   run_preset(preset, frames, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, length, F);
   (length <= 1 ? Totals::get() : Totals::sequences()).add(F);

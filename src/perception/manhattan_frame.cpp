@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace stairguide {
 
@@ -22,55 +23,126 @@ Pose manhattan_pose_from_yaw(float yaw) {
   return T;
 }
 
-ManhattanTracker::ManhattanTracker(const ManhattanConfig& config) : cfg_(config) {}
+ManhattanTracker::ManhattanTracker(const ManhattanConfig& config, float max_range)
+    : cfg_(config), max_range_(max_range) {}
 
 ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera) {
   ManhattanEstimate est;
   const Eigen::Matrix3f R = T_floor_camera.linear();
   const float sin_tol = std::sin(cfg_.vertical_tolerance);
-  // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
-  constexpr int kBins = 90;
-  float hist[kBins] = {};
+  const float cos_tol = std::cos(cfg_.vertical_tolerance);
+  const float camera_height = T_floor_camera.translation().y();  // the floor frame's origin is under the camera
   float total_area = 0.f;
-  struct Vote {
-    float a, w, area, width;
-    float heading;  // the normal's direction in the floor plane, rad, (-pi, pi]
-  };
-  std::vector<Vote> votes;
-  votes.reserve(regions.size());
+  std::vector<Vote>& votes = votes_;
+  votes.clear();
+  // Floor samples (floor frame x and z, with the area each stands for) from every horizontal plane
+  // at the floor's height, not only the floor region: furniture splits the floor in parts.
+  std::vector<FloorSample>& floor_pts = floor_pts_;
+  floor_pts.clear();
+  {
+    auto is_floor = [&](const PlaneRegion& r) {
+      if (r.points.empty() || std::fabs((R * r.normal).y()) < cos_tol) return false;
+      return std::fabs((T_floor_camera * r.centroid).y()) <= cfg_.floor_beyond_height;
+    };
+    std::size_t n_floor = 0;
+    for (const PlaneRegion& r : regions)
+      if (is_floor(r)) n_floor += r.points.size();
+    // A bounded sample keeps the test linear in the number of vertical planes, not in pixels.
+    constexpr std::size_t kMaxFloorSamples = 1024;
+    const std::size_t stride = std::max<std::size_t>(1, (n_floor + kMaxFloorSamples - 1) / kMaxFloorSamples);
+    for (const PlaneRegion& r : regions) {
+      if (!is_floor(r)) continue;
+      const float w = r.area / static_cast<float>(r.points.size()) * static_cast<float>(stride);
+      for (std::size_t i = 0; i < r.points.size(); i += stride) {
+        const Eigen::Vector3f q = T_floor_camera * r.points[i];
+        floor_pts.push_back({q.x(), q.z(), w});
+      }
+    }
+  }
   // Up in camera coordinates: the horizontal direction within a vertical plane is up x normal.
   const Eigen::Vector3f up_c = R.transpose() * Eigen::Vector3f::UnitY();
+  const Eigen::Vector3f cam_f = T_floor_camera.translation();
   const float full_w = std::max(cfg_.yaw_full_width, 1e-3f);
+  const float clip_depth = max_range_ > 0.f ? max_range_ - cfg_.range_clip_margin : std::numeric_limits<float>::max();
   for (const PlaneRegion& r : regions) {
     total_area += r.area;
     const Eigen::Vector3f nf = R * r.normal;
-    if (std::fabs(nf.y()) > sin_tol) continue;
+    if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
     const float heading = std::atan2(nf.x(), nf.z());
     const float a = wrap_quarter(heading);
-    // Horizontal width of the region: the spread of its points along the horizontal in its plane.
+    // Horizontal width of the region: the spread of its points along the horizontal in its plane;
+    // the height of its lowest point; how many of its points lie at the depth cut-off.
     const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
-    float lo = 0.f, hi = 0.f;
-    if (!r.points.empty()) lo = hi = hz.dot(r.points.front());
+    float lo = hz.dot(r.points.front()), hi = lo;
+    float base = std::numeric_limits<float>::max();
+    std::size_t clipped_points = 0;
     for (const Eigen::Vector3f& q : r.points) {
       const float t = hz.dot(q);
       lo = std::min(lo, t);
       hi = std::max(hi, t);
+      base = std::min(base, up_c.dot(q));
+      clipped_points += q.z() > clip_depth;
     }
+    base += camera_height;
     const float width = hi - lo;
     // The yaw of a plane fit is as precise as the plane is wide (lever arm): a person's front,
     // a post or the side of a box a few decimetres wide is off by degrees where a wall or a
     // riser is not. Votes weigh area * (width / full width)^2, the inverse of that variance.
     const float s = std::min(1.f, width / full_w);
     const float w = r.area * s * s;
-    votes.push_back({a, w, r.area, width, heading});
-    int bin = static_cast<int>((a + 0.25f * kPi) / kHalfPi * kBins);
-    bin = (bin % kBins + kBins) % kBins;
-    // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
-    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += w * (3 - std::abs(k));
+    // Does the floor go on beyond this plane? A wall bounds the free space: all the floor lies on
+    // the camera's side of its plane. Furniture, people and risers stand inside the room: the floor
+    // is seen beside and behind them, beyond their plane's extension. The test is in 3D and holds
+    // for any camera tilt (a level camera sees a cupboard's top edge against the wall behind it,
+    // a tilted one does not).
+    Eigen::Vector2f nh(nf.x(), nf.z());
+    float beyond = 0.f;
+    if (nh.norm() > 1e-6f) {
+      nh.normalize();
+      const Eigen::Vector3f cf = T_floor_camera * r.centroid;
+      if (nh.x() * (cam_f.x() - cf.x()) + nh.y() * (cam_f.z() - cf.z()) < 0.f) nh = -nh;
+      for (const FloorSample& f : floor_pts)
+        if (nh.x() * (f.x - cf.x()) + nh.y() * (f.z - cf.z()) < -cfg_.floor_beyond_margin) beyond += f.area;
+    }
+    // A plane reaching below the floor stands in a hole in it (a person on a flight going down,
+    // whose floor beyond is not seen): inside too.
+    const bool inside = beyond >= cfg_.floor_beyond_area || base < -cfg_.floor_beyond_height;
+    // Standing on the floor: its lowest point is at the floor's height. With no floor beyond it,
+    // that is a wall; a person on a flight going down (no floor seen behind them either) stands
+    // below the floor, a wall cabinet or a person's chest above it.
+    const bool grounded = std::fabs(base) <= cfg_.floor_beyond_height;
+    // A plane seen mostly at the depth cut-off is a sliver kept only where the noise fell short of
+    // the cut-off: its fit may be biased by degrees (synthetic walls 5 m away: 1 to 10 degrees off).
+    // It votes, but cannot make a frame of walls alone against the other planes.
+    const bool clipped = 2 * clipped_points > r.points.size();
+    votes.push_back({a, w, r.area, width, heading, inside, grounded, clipped});
   }
   if (votes.empty()) {
     est.why = "no vertical plane";
     return est;
+  }
+  // Planes that bound the floor (walls) make the frame when they can; the rest (furniture turned
+  // against the room, risers, people) vote only when the bounding planes alone make no frame.
+  bool any_bounding = false;
+  for (const Vote& v : votes) any_bounding = any_bounding || !v.inside;
+  if (any_bounding) {
+    ManhattanEstimate walls = solve(votes, total_area, /*bounding_only=*/true);
+    if (walls.found) return walls;
+  }
+  return solve(votes, total_area, /*bounding_only=*/false);
+}
+
+ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float total_area, bool bounding_only) {
+  ManhattanEstimate est;
+  // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
+  constexpr int kBins = 90;
+  float hist[kBins] = {};
+  for (const Vote& v : votes) {
+    if (bounding_only && v.inside) continue;
+    int bin = static_cast<int>((v.a + 0.25f * kPi) / kHalfPi * kBins);
+    bin = (bin % kBins + kBins) % kBins;
+    // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
+    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += v.w * (3 - std::abs(k));
   }
   int peak = 0;
   for (int b = 1; b < kBins; ++b)
@@ -78,6 +150,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
   float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f, widest = 0.f;
+  bool wide = false;
   // Two agreeing planes parallel to each other (modulo 180 degrees: two risers, two strips of one
   // wall, a wall and a riser) are structure; two faces of one box at right angles (a person, a
   // bin) agree modulo 90 degrees by construction and prove nothing.
@@ -85,6 +158,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   std::vector<float>& headings = headings_;
   headings.clear();
   for (const Vote& v : votes) {
+    if (bounding_only && v.inside) continue;
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     for (const float h : headings) {
       float d = std::fmod(std::fabs(v.heading - h), kPi);  // modulo 180 degrees
@@ -94,12 +168,17 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     headings.push_back(v.heading);
   }
   for (const Vote& v : votes) {
+    if (bounding_only && v.inside) continue;
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     sc += v.w * std::cos(4.f * v.a);
     ss += v.w * std::sin(4.f * v.a);
     agree += v.area;
     wsum_agree += v.w;
+    if (bounding_only && v.clipped) continue;
     widest = std::max(widest, v.width);
+    // A wall standing on the floor is trusted from a narrower strip than other planes: people and
+    // posts, whose yaw is off by degrees, have floor beside them or do not stand at its height.
+    wide = wide || v.width >= (bounding_only && v.grounded ? cfg_.min_bounding_width : cfg_.min_plane_width);
   }
   est.vertical_area = agree;
   est.fraction = total_area > 0.f ? agree / total_area : 0.f;
@@ -121,8 +200,9 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   const float wsum = std::max(wsum_agree, 1e-12f);
   const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
   const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
-  if (widest < cfg_.min_plane_width && (!parallel_pair || spread > cfg_.max_spread || widest < 0.5f * cfg_.min_plane_width)) {
-    est.why = "no wide vertical plane, and the narrow ones disagree by degrees (no wall or riser in view)";
+  if (!wide && (!parallel_pair || spread > cfg_.max_spread || widest < 0.5f * cfg_.min_plane_width)) {
+    est.why = "no wide vertical plane, and the narrow ones are one, too narrow or disagree by degrees (no wall or "
+              "riser in view, or too little of one to trust)";
     return est;
   }
   float yaw = wrap_quarter(0.25f * std::atan2(ss, sc));

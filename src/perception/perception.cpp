@@ -22,10 +22,14 @@ const char* to_string(RegionClass c) {
 
 Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor, const ManhattanConfig& manhattan,
                        const ClassificationConfig& classification)
-    : segmentation_(seg), floor_(floor), manhattan_(manhattan), classification_(classification) {}
+    : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range),
+      classification_(classification) {}
 
 Perception::Perception(const PipelineConfig& c)
-    : Perception(c.segmentation, c.floor, c.manhattan, c.classification) {}
+    : Perception(c.segmentation, c.floor, c.manhattan, c.classification) {
+  // Vertical planes seen at the depth cut-off give the Manhattan frame no direction.
+  manhattan_ = ManhattanTracker(c.manhattan, c.capture.max_range);
+}
 
 void Perception::reset() {
   floor_.reset();

@@ -194,6 +194,11 @@ struct ManhattanConfig {
   float yaw_full_width = 1.0f;   ///< m, a vertical plane's vote weighs area * min(1, width / this)^2 (its yaw's precision grows with its width)
   float min_plane_width = 0.6f;    ///< m, an agreeing vertical plane this wide (a wall, a riser) makes the frame trusted ...
   float max_spread = 0.02617994f;  ///< rad, ... else the agreeing votes' weighted spread must stay below this (1.5 deg)
+  float floor_beyond_margin = 0.25f;  ///< m, floor this far beyond a vertical plane shows it stands inside the room ...
+  float floor_beyond_area = 0.05f;    ///< m^2, ... when this much floor lies there (furniture, risers; not a wall)
+  float floor_beyond_height = 0.05f;  ///< m, horizontal planes within this of the floor count as floor for that test
+  float min_bounding_width = 0.3f;    ///< m, min_plane_width for planes standing on the floor with no floor beyond them (walls)
+  float range_clip_margin = 0.25f;    ///< m, a vertical plane with most points this near the depth cut-off cannot make a frame of walls alone
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -207,6 +212,18 @@ struct ManhattanConfig {
           "an agreeing vertical plane this wide (a wall, a riser) makes the frame trusted; people and posts are narrower");
     v.num(max_spread, "max_spread_deg", Unit::kDegree, 0.1, 45,
           "without such a plane, the agreeing planes (weighted) may spread this much at most");
+    v.num(floor_beyond_margin, "floor_beyond_margin_cm", Unit::kCentimetre, 0, 500,
+          "floor farther than this beyond a vertical plane's extension marks it as standing inside the room");
+    v.num(floor_beyond_area, "floor_beyond_area_m2", Unit::kNone, 0, 100,
+          "square metres of floor beyond a vertical plane that make it furniture or a riser, not a wall "
+          "(such planes vote only when the walls alone make no frame)");
+    v.num(floor_beyond_height, "floor_beyond_height_cm", Unit::kCentimetre, 0.5, 50,
+          "horizontal planes within this of the floor count as floor for the test above");
+    v.num(min_bounding_width, "min_bounding_width_cm", Unit::kCentimetre, 0, 1000,
+          "min_plane_width for vertical planes standing on the floor with no floor beyond them (walls)");
+    v.num(range_clip_margin, "range_clip_margin_cm", Unit::kCentimetre, 0, 200,
+          "a vertical plane with most of its points this near the depth cut-off (capture max_range) cannot make a "
+          "frame of walls alone: its fit may be biased");
   }
 };
 

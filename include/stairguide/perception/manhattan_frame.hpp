@@ -6,6 +6,9 @@
 /// yaw, refined by a circular mean of the votes near the peak; no frame when no agreeing plane is
 /// min_plane_width wide and the agreeing votes spread more than max_spread or hold no two
 /// parallel planes, e.g. only people and posts in view).
+/// Planes with floor beyond them (furniture, risers, people: they stand inside the room) vote only
+/// when the others (walls, which bound the floor) make no frame; a wall standing on the floor is
+/// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -33,16 +36,34 @@ Pose manhattan_pose_from_yaw(float yaw);
 
 class ManhattanTracker {
  public:
-  explicit ManhattanTracker(const ManhattanConfig& config = {});
+  /// `max_range`: the depth (m) beyond which the sensor gives no reading (CaptureConfig::max_range);
+  /// planes seen mostly within ManhattanConfig::range_clip_margin of it cannot make a frame of walls
+  /// alone (they still vote). 0: no such test.
+  explicit ManhattanTracker(const ManhattanConfig& config = {}, float max_range = 0.f);
 
   /// Estimates the Manhattan frame from the vertical planes among `regions`, given the floor.
   ManhattanEstimate estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
   void reset() { prev_yaw_.reset(); }
 
  private:
+  struct Vote {
+    float a, w, area, width;
+    float heading;  // the normal's direction in the floor plane, rad, (-pi, pi]
+    bool inside;    // the floor goes on beyond the plane: furniture, a riser, a person, not a wall
+    bool grounded;  // its lowest point is at the floor's height
+    bool clipped;   // most of its points lie at the depth cut-off
+  };
+  struct FloorSample {
+    float x, z, area;  // floor frame, m; m^2 it stands for
+  };
+  ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, bool bounding_only);
+
   ManhattanConfig cfg_;
+  float max_range_ = 0.f;
   std::optional<float> prev_yaw_;
   std::vector<float> headings_;  // scratch: agreeing planes' headings
+  std::vector<Vote> votes_;               // scratch
+  std::vector<FloorSample> floor_pts_;    // scratch
 };
 
 }  // namespace stairguide
