@@ -320,6 +320,42 @@ TEST(Dataset, WriterRefusesToOverwrite) {
   EXPECT_NE(e.find("refusing"), std::string::npos) << e;
 }
 
+TEST(OpenFrameSource, DepthOutsideTheConfiguredRangeIsNoReading) {
+  const fs::path d = small_dataset("range");
+  const std::string png = (d / "depth" / "000000.png").string();
+  const RgbdFrame raw = read_depth_png_frame(png);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(raw.depth, &lo, &hi, nullptr, nullptr, raw.depth > 0);
+  ASSERT_GT(hi - lo, 0.1) << "the test frame needs a spread of depths";
+  CaptureConfig c;
+  c.min_range = static_cast<float>(lo + 0.25 * (hi - lo));
+  c.max_range = static_cast<float>(hi - 0.25 * (hi - lo));
+  auto src = open_frame_source(png, c);
+  RgbdFrame f;
+  ASSERT_TRUE(src->read(f).ok());
+  int dropped = 0, kept = 0;
+  for (int v = 0; v < raw.depth.rows; ++v)
+    for (int u = 0; u < raw.depth.cols; ++u) {
+      const float z = raw.depth.at<float>(v, u), g = f.depth.at<float>(v, u);
+      if (z >= c.min_range && z <= c.max_range) {
+        EXPECT_EQ(g, z);
+        ++kept;
+      } else {
+        EXPECT_EQ(g, 0.f) << "depth " << z << " outside " << c.min_range << ".." << c.max_range;
+        dropped += z > 0.f;
+      }
+    }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(dropped, 0);
+  // The same through a dataset folder.
+  auto ds = open_frame_source(d.string(), c);
+  ASSERT_TRUE(ds->read(f).ok());
+  double flo = 0, fhi = 0;
+  cv::minMaxLoc(f.depth, &flo, &fhi, nullptr, nullptr, f.depth > 0);
+  EXPECT_GE(flo, c.min_range);
+  EXPECT_LE(fhi, c.max_range);
+}
+
 TEST(OpenFrameSource, PicksTheSourceByInputName) {
   const fs::path d = small_dataset("factory");
   CaptureConfig c;

@@ -46,9 +46,48 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
   return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed);
 }
 
+// capture.min_range_m / max_range_m: depth outside them is no reading, for every consumer
+// (perception, odometry, the CLI) and every source, whatever the sensor or file holds. Beyond
+// ~5 m a Kinect-class sensor's noise is several centimetres and its quantisation steps coarser
+// still; nearer than its minimum range it reads garbage.
+class RangeGatedSource final : public FrameSource {
+ public:
+  RangeGatedSource(std::unique_ptr<FrameSource> inner, float min_range, float max_range)
+      : inner_(std::move(inner)), lo_(min_range), hi_(max_range) {}
+  ReadResult read(RgbdFrame& out) override {
+    ReadResult r = inner_->read(out);
+    if (r.ok() && out.depth.type() == CV_32FC1) {
+      for (int v = 0; v < out.depth.rows; ++v) {
+        float* row = out.depth.ptr<float>(v);
+        for (int u = 0; u < out.depth.cols; ++u)
+          if (!(row[u] >= lo_ && row[u] <= hi_)) row[u] = 0.f;  // NaN too
+      }
+    }
+    return r;
+  }
+  CameraIntrinsics intrinsics() const override { return inner_->intrinsics(); }
+  long frame_count() const override { return inner_->frame_count(); }
+  std::string describe() const override { return inner_->describe(); }
+  std::optional<FrameTruth> truth() const override { return inner_->truth(); }
+  bool is_live() const override { return inner_->is_live(); }
+  bool independent_frames() const override { return inner_->independent_frames(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  float lo_, hi_;
+};
+
+std::unique_ptr<FrameSource> open_ungated(const std::string& input, const CaptureConfig& config);
+
 }  // namespace
 
 std::unique_ptr<FrameSource> open_frame_source(const std::string& input, const CaptureConfig& config) {
+  return std::make_unique<RangeGatedSource>(open_ungated(input, config), config.min_range, config.max_range);
+}
+
+namespace {
+
+std::unique_ptr<FrameSource> open_ungated(const std::string& input, const CaptureConfig& config) {
   if (input.empty())
     throw SourceError(
         "no input given (a dataset folder, FILE.oni, FILE.pcd, FILE.png, device[:URI] or synth:SCENE)");
@@ -72,4 +111,5 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& input, const C
                     "or synth:SCENE[:FRAMES[:SEED]])");
 }
 
+}  // namespace
 }  // namespace stairguide

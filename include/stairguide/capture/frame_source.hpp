@@ -62,6 +62,7 @@ class FrameSource {
 
 /// Opens an input by name: a directory is a dataset folder, a path ending in .oni an OpenNI2
 /// recording, "device" or "device:URI" the live camera, "synth:SCENE[:FRAMES[:SEED]]" the renderer.
+/// Depth outside [config.min_range, config.max_range] reads as no reading (0), whatever the source.
 /// Throws SourceError with a clear message when it cannot.
 std::unique_ptr<FrameSource> open_frame_source(const std::string& input, const CaptureConfig& config);
 
