@@ -166,10 +166,6 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
       parallel_pair = parallel_pair || d <= cfg_.cluster_tolerance;
     }
     headings.push_back(v.heading);
-  }
-  for (const Vote& v : votes) {
-    if (bounding_only && v.inside) continue;
-    if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     sc += v.w * std::cos(4.f * v.a);
     ss += v.w * std::sin(4.f * v.a);
     agree += v.area;
@@ -193,10 +189,10 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
   // A frame is trusted when a wide plane (a wall, a riser) supports it, or when narrow ones
   // agree tightly and two of them are parallel (strips of wall at the view's edge, the risers of a
   // flight seen in part; one narrow plane, a post or a person, agrees with itself and proves
-  // nothing). People, posts and the sides of boxes are
-  // narrow and agree only to degrees: their yaw is no frame. (The spread check alone refused
-  // most real kitchen views, whose walls and cupboards agree only to a few degrees; the width
-  // check alone refused a corridor seen as a 35 cm strip of wall.)
+  // nothing). People, posts and the sides of boxes are narrow and agree only to degrees: their yaw
+  // is no frame. (The spread check alone refused most real kitchen views, whose walls and
+  // cupboards agree only to a few degrees; the width check alone refused a corridor seen as a
+  // 35 cm strip of wall.)
   const float wsum = std::max(wsum_agree, 1e-12f);
   const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
   const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
