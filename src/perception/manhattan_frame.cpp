@@ -59,12 +59,37 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
       }
     }
   }
+  // Samples of every other region (floor frame x and z, the area each stands for, the region),
+  // at most kMaxRegionSamples per region so that a small far wall is not lost among big regions.
+  std::vector<StructureSample>& struct_pts = struct_pts_;
+  struct_pts.clear();
+  {
+    constexpr std::size_t kMaxRegionSamples = 48;
+    for (std::size_t k = 0; k < regions.size(); ++k) {
+      const PlaneRegion& r = regions[k];
+      if (r.points.empty()) continue;
+      const bool floor_like = std::fabs((R * r.normal).y()) >= cos_tol &&
+                              std::fabs((T_floor_camera * r.centroid).y()) <= cfg_.floor_beyond_height;
+      if (floor_like) continue;  // the floor has its own test (floor_pts)
+      const std::size_t stride =
+          std::max<std::size_t>(1, (r.points.size() + kMaxRegionSamples - 1) / kMaxRegionSamples);
+      const std::size_t n = (r.points.size() + stride - 1) / stride;
+      const float w = r.area / static_cast<float>(n);
+      for (std::size_t i = 0; i < r.points.size(); i += stride) {
+        const Eigen::Vector3f q = T_floor_camera * r.points[i];
+        struct_pts.push_back({q.x(), q.z(), w, static_cast<int>(k)});
+      }
+    }
+  }
   // Up in camera coordinates: the horizontal direction within a vertical plane is up x normal.
   const Eigen::Vector3f up_c = R.transpose() * Eigen::Vector3f::UnitY();
   const Eigen::Vector3f cam_f = T_floor_camera.translation();
   const float full_w = std::max(cfg_.yaw_full_width, 1e-3f);
   const float clip_depth = max_range_ > 0.f ? max_range_ - cfg_.range_clip_margin : std::numeric_limits<float>::max();
-  for (const PlaneRegion& r : regions) {
+  std::vector<int>& vote_of_region = vote_of_region_;
+  vote_of_region.assign(regions.size(), -1);
+  for (std::size_t k = 0; k < regions.size(); ++k) {
+    const PlaneRegion& r = regions[k];
     total_area += r.area;
     const Eigen::Vector3f nf = R * r.normal;
     if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
@@ -90,23 +115,6 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     // riser is not. Votes weigh area * (width / full width)^2, the inverse of that variance.
     const float s = std::min(1.f, width / full_w);
     const float w = r.area * s * s;
-    // Does the floor go on beyond this plane? A wall bounds the free space: all the floor lies on
-    // the camera's side of its plane. Furniture, people and risers stand inside the room: the floor
-    // is seen beside and behind them, beyond their plane's extension. The test is in 3D and holds
-    // for any camera tilt (a level camera sees a cupboard's top edge against the wall behind it,
-    // a tilted one does not).
-    Eigen::Vector2f nh(nf.x(), nf.z());
-    float beyond = 0.f;
-    if (nh.norm() > 1e-6f) {
-      nh.normalize();
-      const Eigen::Vector3f cf = T_floor_camera * r.centroid;
-      if (nh.x() * (cam_f.x() - cf.x()) + nh.y() * (cam_f.z() - cf.z()) < 0.f) nh = -nh;
-      for (const FloorSample& f : floor_pts)
-        if (nh.x() * (f.x - cf.x()) + nh.y() * (f.z - cf.z()) < -cfg_.floor_beyond_margin) beyond += f.area;
-    }
-    // A plane reaching below the floor stands in a hole in it (a person on a flight going down,
-    // whose floor beyond is not seen): inside too.
-    const bool inside = beyond >= cfg_.floor_beyond_area || base < -cfg_.floor_beyond_height;
     // Standing on the floor: its lowest point is at the floor's height. With no floor beyond it,
     // that is a wall; a person on a flight going down (no floor seen behind them either) stands
     // below the floor, a wall cabinet or a person's chest above it.
@@ -115,21 +123,111 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     // the cut-off: its fit may be biased by degrees (synthetic walls 5 m away: 1 to 10 degrees off).
     // It votes, but cannot make a frame of walls alone against the other planes.
     const bool clipped = 2 * clipped_points > r.points.size();
-    votes.push_back({a, w, r.area, width, heading, inside, grounded, clipped});
+    // Such a plane is biased where the cut-off runs along it: a sliver a few centimetres wide lies
+    // wholly in the noise band at the cut-off (10 degrees off seen), a wider patch mostly not.
+    const bool sliver = clipped && r.rect_length_minor < cfg_.sliver_width;
+    // A plane reaching below the floor stands in a hole in it (a person on a flight going down,
+    // whose floor beyond is not seen): inside, like the planes with floor beyond them (below).
+    const bool below = base < -cfg_.floor_beyond_height;
+    vote_of_region[k] = static_cast<int>(votes.size());
+    votes.push_back({a, w, r.area, width, heading, below, grounded, clipped, static_cast<int>(k), below, sliver});
   }
   if (votes.empty()) {
     est.why = "no vertical plane";
     return est;
   }
-  // Planes that bound the floor (walls) make the frame when they can; the rest (furniture turned
+  // Does something lie beyond each vertical plane? A wall bounds the room: the floor and every
+  // other surface lie on the camera's side of its plane. Furniture, people and risers stand inside
+  // the room: the floor, the wall behind them, a seat or the treads above are seen beyond their
+  // plane's extension. The test is in 3D and holds for any camera tilt (a level camera sees a
+  // cupboard's top edge against the wall behind it, a tilted one does not).
+  //  - Floor beyond: `inside`, the plane votes only when the walls make no frame.
+  //  - Any other surface beyond: `backed`, not a wall, it cannot veto a frame (below). It does not
+  //    make the plane `inside`: a kitchen's cupboard fronts have the worktop beyond them and agree
+  //    with its walls only to a few degrees; taking them out of the walls' frame moved the kitchen's
+  //    frames by up to 2 degrees in the world (and more views apart).
+  //  - A vertical plane beyond that disagrees with this one modulo 90 degrees: a pair kept for the
+  //    veto. One that agrees (a wall past a convex corner, the wall behind a bookcase standing
+  //    square to it) says nothing against it.
+  std::vector<float>& beyond_by_region = beyond_by_region_;
+  std::vector<std::pair<int, int>>& pairs = beyond_pairs_;
+  pairs.clear();
+  for (std::size_t i = 0; i < votes.size(); ++i) {
+    Vote& v = votes[i];
+    const PlaneRegion& r = regions[static_cast<std::size_t>(v.region)];
+    const Eigen::Vector3f nf = R * r.normal;
+    Eigen::Vector2f nh(nf.x(), nf.z());
+    if (nh.norm() <= 1e-6f) continue;
+    nh.normalize();
+    const Eigen::Vector3f cf = T_floor_camera * r.centroid;
+    if (nh.x() * (cam_f.x() - cf.x()) + nh.y() * (cam_f.z() - cf.z()) < 0.f) nh = -nh;
+    // A point p lies beyond the plane by more than the margin when nh . (p - cf) < -margin.
+    const float limit = nh.x() * cf.x() + nh.y() * cf.z() - cfg_.floor_beyond_margin;
+    float floor_beyond = 0.f;
+    for (const FloorSample& f : floor_pts)
+      if (nh.x() * f.x + nh.y() * f.z < limit) floor_beyond += f.area;
+    beyond_by_region.assign(regions.size(), 0.f);
+    for (const StructureSample& q : struct_pts)
+      if (q.region != v.region && nh.x() * q.x + nh.y() * q.z < limit)
+        beyond_by_region[static_cast<std::size_t>(q.region)] += q.area;
+    float any_beyond = 0.f;
+    for (std::size_t k = 0; k < regions.size(); ++k) {
+      if (beyond_by_region[k] <= 0.f) continue;
+      any_beyond += beyond_by_region[k];
+      const int j = vote_of_region[k];
+      if (j < 0) continue;
+      const Vote& vj = votes[static_cast<std::size_t>(j)];
+      if (std::fabs(wrap_quarter(vj.a - v.a)) <= std::max(disagree_tolerance(v), disagree_tolerance(vj))) continue;
+      // Disagrees: if the plane beyond is a wall, this plane's frame is contradicted (checked once
+      // the frame is known).
+      if (beyond_by_region[k] >= cfg_.structure_beyond_area) pairs.emplace_back(static_cast<int>(i), j);
+    }
+    v.inside = v.inside || floor_beyond >= cfg_.floor_beyond_area;
+    v.backed = v.inside || any_beyond >= cfg_.structure_beyond_area;
+  }
+  // Planes that bound the room (walls) make the frame when they can; the rest (furniture turned
   // against the room, risers, people) vote only when the bounding planes alone make no frame.
   bool any_bounding = false;
   for (const Vote& v : votes) any_bounding = any_bounding || !v.inside;
-  if (any_bounding) {
-    ManhattanEstimate walls = solve(votes, total_area, /*bounding_only=*/true);
-    if (walls.found) return walls;
+  bool bounding_only = any_bounding;
+  ManhattanEstimate frame;
+  if (any_bounding) frame = solve(votes, total_area, /*bounding_only=*/true);
+  if (!frame.found) {
+    bounding_only = false;
+    frame = solve(votes, total_area, /*bounding_only=*/false);
   }
-  return solve(votes, total_area, /*bounding_only=*/false);
+  if (!frame.found) return frame;
+  // A wall seen beyond the planes that make the frame, disagreeing with them: they are furniture
+  // turned against the room (a sofa, shelves, clutter filling the view) and the wall, too small,
+  // too far or clipped to make a frame of its own, says their frame is wrong. No frame is safer
+  // than a wrong one (synthetic views: 17, 31 and 40 degrees off before). A wall at right angles
+  // past a convex corner agrees modulo 90 degrees.
+  for (const auto& [near, far] : pairs) {
+    const Vote& vn = votes[static_cast<std::size_t>(near)];
+    const Vote& vf = votes[static_cast<std::size_t>(far)];
+    if (bounding_only && vn.inside) continue;  // did not make this frame
+    if (vf.backed) continue;                   // not a wall: something lies beyond it too
+    // A wall stands on the floor or goes on past the depth cut-off; a plane floating above the
+    // floor and ending within range with nothing seen behind it may be a person's upper body.
+    if (!vf.grounded && !vf.clipped) continue;
+    // A narrow plane's yaw is off by degrees (a cupboard's side 6 cm wide in the kitchen: 9 deg).
+    if (vf.width < cfg_.veto_min_width) continue;
+    if (std::fabs(wrap_quarter(vn.a - frame.yaw)) > cfg_.cluster_tolerance) continue;
+    if (std::fabs(wrap_quarter(vf.a - frame.yaw)) <= disagree_tolerance(vf)) continue;
+    est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
+              "the room in front of it)";
+    est.fraction = frame.fraction;
+    est.vertical_area = frame.vertical_area;
+    return est;
+  }
+  prev_yaw_ = frame.yaw;
+  return frame;
+}
+
+float ManhattanTracker::disagree_tolerance(const Vote& v) const {
+  // A sliver seen at the depth cut-off may be off by up to 10 degrees (see `sliver`): it
+  // contradicts another direction only by more than that.
+  return v.sliver ? std::max(cfg_.cluster_tolerance, cfg_.clipped_disagreement) : cfg_.cluster_tolerance;
 }
 
 ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float total_area, bool bounding_only) {
@@ -219,7 +317,6 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
   est.found = true;
   est.yaw = yaw;
   est.T_manhattan_floor = manhattan_pose_from_yaw(yaw);
-  prev_yaw_ = yaw;
   return est;
 }
 

@@ -199,6 +199,10 @@ struct ManhattanConfig {
   float floor_beyond_height = 0.05f;  ///< m, horizontal planes within this of the floor count as floor for that test
   float min_bounding_width = 0.3f;    ///< m, min_plane_width for planes standing on the floor with no floor beyond them (walls)
   float range_clip_margin = 0.25f;    ///< m, a vertical plane with most points this near the depth cut-off cannot make a frame of walls alone
+  float structure_beyond_area = 0.02f;  ///< m^2, other surfaces this large beyond a vertical plane make it no wall; a wall this large beyond a frame's plane may veto it ...
+  float veto_min_width = 0.2f;          ///< m, ... when at least this wide
+  float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
+  float clipped_disagreement = 0.2617994f;  ///< rad, ... and contradicts another direction only beyond this (15 deg)
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -224,6 +228,18 @@ struct ManhattanConfig {
     v.num(range_clip_margin, "range_clip_margin_cm", Unit::kCentimetre, 0, 200,
           "a vertical plane with most of its points this near the depth cut-off (capture max_range) cannot make a "
           "frame of walls alone: its fit may be biased");
+    v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
+          "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
+          "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "
+          "a plane that makes the frame, and disagreeing with the frame modulo 90 deg, vetoes the frame (no frame)");
+    v.num(veto_min_width, "veto_min_width_cm", Unit::kCentimetre, 0, 1000,
+          "narrowest wall that may veto a frame as above: a narrower plane's yaw is off by degrees");
+    v.num(sliver_width, "sliver_width_cm", Unit::kCentimetre, 0, 200,
+          "a vertical plane seen mostly at the depth cut-off and narrower than this in its narrowest in-plane "
+          "direction is a sliver whose yaw may be off by up to 10 deg");
+    v.num(clipped_disagreement, "clipped_disagreement_deg", Unit::kDegree, 0.5, 45,
+          "a sliver contradicts another direction, modulo 90 deg, only when it differs by more than this (other "
+          "planes: cluster_tolerance)");
   }
 };
 

@@ -9,11 +9,16 @@
 /// Planes with floor beyond them (furniture, risers, people: they stand inside the room) vote only
 /// when the others (walls, which bound the floor) make no frame; a wall standing on the floor is
 /// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame.
+/// A wall (no surface at all beyond it, standing on the floor or reaching the cut-off, at least
+/// veto_min_width wide) seen beyond a plane that makes the frame and disagreeing with the frame
+/// modulo 90 degrees vetoes it: no frame (`why` says so) rather than the frame of furniture turned
+/// against the room; a sliver at the cut-off disagrees only beyond clipped_disagreement.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stairguide/core/config.hpp"
@@ -49,13 +54,22 @@ class ManhattanTracker {
   struct Vote {
     float a, w, area, width;
     float heading;  // the normal's direction in the floor plane, rad, (-pi, pi]
-    bool inside;    // the floor goes on beyond the plane: furniture, a riser, a person, not a wall
+    bool inside;    // the floor goes on beyond the plane (or it reaches below the floor): furniture, a riser, a person
     bool grounded;  // its lowest point is at the floor's height
     bool clipped;   // most of its points lie at the depth cut-off
+    int region;     // index in the regions
+    bool backed;    // inside, or any other surface (a countertop, a seat, treads, a wall) lies beyond it
+    bool sliver;    // clipped, and narrower than ManhattanConfig::sliver_width: its yaw may be off by 10 degrees
+  };
+  struct StructureSample {
+    float x, z, area;  // floor frame, m; m^2 it stands for
+    int region;        // index in the regions
   };
   struct FloorSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
   };
+  /// Angle modulo 90 degrees by which a plane must differ from another direction to contradict it.
+  float disagree_tolerance(const Vote& v) const;
   ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, bool bounding_only);
 
   ManhattanConfig cfg_;
@@ -64,6 +78,10 @@ class ManhattanTracker {
   std::vector<float> headings_;  // scratch: agreeing planes' headings
   std::vector<Vote> votes_;               // scratch
   std::vector<FloorSample> floor_pts_;    // scratch
+  std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
+  std::vector<int> vote_of_region_;          // scratch: vote index of each region, -1 if not vertical
+  std::vector<float> beyond_by_region_;      // scratch: m^2 of each region beyond one plane
+  std::vector<std::pair<int, int>> beyond_pairs_;  // scratch: (plane, disagreeing vertical plane beyond it)
 };
 
 }  // namespace stairguide
