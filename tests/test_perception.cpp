@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "stairguide/perception/perception.hpp"
+#include "manhattan_test_util.hpp"
 
 using namespace stairguide;
 
@@ -339,6 +340,7 @@ struct PresetFigures {
   int frames = 0, floor_visible = 0, floor_ok = 0, floor_wrong_plane = 0;
   int treads = 0, treads_ok = 0, mixed = 0, manhattan_checked = 0, manhattan_ok = 0;
   int manhattan_wrong = 0;  // frames off by more than 2 degrees with a staircase in view
+  int manhattan_off = 0;    // frames off by more than 2 degrees with a wall or riser in view
   // Tread failures by kind: no horizontal region at its height, or found with a normal, a
   // height or a class out of bounds (one tread may fail several ways).
   int tread_missed = 0, tread_bad_normal = 0, tread_bad_height = 0, tread_bad_class = 0;
@@ -349,13 +351,7 @@ struct PresetFigures {
 // A wall or riser this many pixels (with depth readings) is "visible" for the Manhattan figure.
 constexpr int kMinWallOrRiserPixels = 200;
 
-float wrap45(float a) {
-  const float q = 90 * kDeg;
-  a = std::fmod(a, q);
-  if (a > 0.5f * q) a -= q;
-  if (a < -0.5f * q) a += q;
-  return a;
-}
+using sg_test::wrap45;
 
 // Height of the tread surface above the stair's base floor, and in the stair frame.
 float tread_height(const StairTruth& s, int k) {
@@ -448,17 +444,7 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
     // kMinWallOrRiserPixels with depth readings (a view without a frame counts as a miss), and
     // checked wherever else a frame is reported with a staircase in view.
     const bool wall_or_riser = truth->floor_visible && truth->wall_or_riser_pixels >= kMinWallOrRiserPixels;
-    float yaw_err = -1.f;  // degrees; < 0: no frame
-    if (sc.floor_found && sc.manhattan_found) {
-      const Eigen::Vector3f kF(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw));
-      const Eigen::Vector3f kW = Rwc * (sc.T_floor_camera.linear().transpose() * kF);
-      float err = std::fabs(wrap45(std::atan2(kW.y(), kW.x())));
-      for (const StairTruth& st : truth->stairs) {
-        const Eigen::Vector3f zs = Rwc * st.T_camera_stair.linear().col(2);
-        err = std::min(err, std::fabs(wrap45(std::atan2(kW.y(), kW.x()) - std::atan2(zs.y(), zs.x()))));
-      }
-      yaw_err = err / kDeg;
-    }
+    const float yaw_err = sg_test::manhattan_yaw_error_deg(sc, *truth);  // degrees; < 0: no frame
     if (wall_or_riser) {
       ++F.manhattan_checked;
       if (yaw_err >= 0.f && yaw_err <= 2.f) ++F.manhattan_ok;
@@ -485,6 +471,7 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
       F.worst_yaw = std::max(F.worst_yaw, yaw_err);
       if (yaw_err > 2.f) {
         F.manhattan_wrong += truth->any_stair_visible();
+        F.manhattan_off += wall_or_riser;
         std::printf("  %s #%llu: Manhattan yaw off by %.2f deg (wall or riser %d px)\n", preset.c_str(),
                     static_cast<unsigned long long>(truth->index), yaw_err, truth->wall_or_riser_pixels);
       }
@@ -618,6 +605,7 @@ struct Totals {
     all.manhattan_checked += F.manhattan_checked;
     all.manhattan_ok += F.manhattan_ok;
     all.manhattan_wrong += F.manhattan_wrong;
+    all.manhattan_off += F.manhattan_off;
   }
 };
 
@@ -630,11 +618,12 @@ class TotalsCheck : public ::testing::Environment {
     for (int k = 0; k < 2; ++k) {
       const PresetFigures& A = (k == 0 ? Totals::get() : Totals::sequences()).all;
       std::printf("ALL %s: frames %d floor %d/%d (%.1f %%) wrong plane %d | treads %d/%d (%.1f %%) (missed %d, "
-                  "normal %d, height %d, class %d) mixed %d | manhattan %d/%d (wrong %d)\n",
+                  "normal %d, height %d, class %d) mixed %d | manhattan %d/%d (wrong %d, off with a wall in view %d)\n",
                   k == 0 ? "STATIC PRESETS" : "SEQUENCE WINDOWS", A.frames, A.floor_ok, A.floor_visible,
                   100.0 * A.floor_ok / std::max(1, A.floor_visible), A.floor_wrong_plane, A.treads_ok, A.treads,
                   100.0 * A.treads_ok / std::max(1, A.treads), A.tread_missed, A.tread_bad_normal,
-                  A.tread_bad_height, A.tread_bad_class, A.mixed, A.manhattan_ok, A.manhattan_checked, A.manhattan_wrong);
+                  A.tread_bad_height, A.tread_bad_class, A.mixed, A.manhattan_ok, A.manhattan_checked, A.manhattan_wrong,
+                  A.manhattan_off);
     }
     const PresetFigures& A = Totals::get().all;
     EXPECT_EQ(Totals::get().presets, statics);
@@ -659,9 +648,12 @@ class TotalsCheck : public ::testing::Environment {
     // 208/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
     //  - walls and risers seen too small or narrow to trust (9 views), and a 450 px strip of wall
-    //    while turning (8 walking views);
+    //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
+    //    world through them, see test_walk_manhattan);
     //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
-    //    shows only as a strip too narrow or too far to make a frame of its own (5 views);
+    //    shows only as a strip too narrow or too far to make a frame of its own (5 views): 4 now
+    //    report no frame (a wall seen beyond the planes making it disagrees), sofa #0 is 2.08 deg
+    //    off (its far wall disagrees by only 2.5 deg);
     //  - no floor found although it is in view (4 views).
     // History: counted only on views reporting a frame, 143/143. On every view: 209/241 once the
     // paper's 5 % share of planar area (it refused curbs' and single steps' risers 1.3 m wide) was
@@ -672,6 +664,7 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
     EXPECT_GE(A.manhattan_ok, 206) << "Manhattan frame within 2 deg where a wall or riser is in view (208/226)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
+    EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }
 };
 const auto* const kTotals = ::testing::AddGlobalTestEnvironment(new TotalsCheck);
@@ -991,40 +984,21 @@ TEST(PerceptionRealData, KitchenManhattanFrameHoldsStillInTheWorld) {
                        .toRotationMatrix());
   }
   ASSERT_EQ(files.size(), R_wc.size());
-  std::vector<Eigen::Vector3f> k_world, up_world;
+  sg_test::WorldManhattan world;
   for (std::size_t i = 0; i < files.size(); i += 10) {
     const RgbdFrame f = read_depth_png_frame(kitchen + "/" + files[i]);
     Perception P;  // each view on its own: nothing carried over
     SceneResult sc;
     P.process(f, sc);
-    if (!sc.floor_found || !sc.manhattan_found) continue;
-    const Eigen::Matrix3f R_fc = sc.T_floor_camera.linear();  // camera into floor
-    const Eigen::Vector3f k_f(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw));
-    k_world.push_back(R_wc[i] * (R_fc.transpose() * k_f));
-    up_world.push_back(R_wc[i] * (R_fc.transpose() * Eigen::Vector3f::UnitY()));
+    if (sc.floor_found && sc.manhattan_found) world.add(sc, R_wc[i]);
   }
   // Measured: 16 of the 30 views (the others have no floor in view, or too little wall), every
   // one within 1.68 degrees of the views' mean.
-  ASSERT_GE(k_world.size(), 13u) << "Manhattan frame found on too few kitchen views";
-  Eigen::Vector3f u = Eigen::Vector3f::Zero();
-  for (const auto& v : up_world) u += v;
-  u.normalize();
-  Eigen::Vector3f e = Eigen::Vector3f::UnitX() - u * u.x();
-  if (e.norm() < 0.1f) e = Eigen::Vector3f::UnitZ() - u * u.z();
-  e.normalize();
-  const Eigen::Vector3f e2 = u.cross(e);
-  // Yaw about the mean vertical, period 90 degrees: circular mean of 4 * yaw.
-  std::vector<float> yaw;
-  float c = 0.f, s = 0.f;
-  for (const auto& k : k_world) {
-    yaw.push_back(std::atan2(e2.dot(k), e.dot(k)));
-    c += std::cos(4.f * yaw.back());
-    s += std::sin(4.f * yaw.back());
-  }
-  const float mean = 0.25f * std::atan2(s, c);
+  ASSERT_GE(world.k.size(), 13u) << "Manhattan frame found on too few kitchen views";
+  const float mean = world.mean_yaw();
   float worst = 0.f;
-  for (float a : yaw) worst = std::max(worst, std::fabs(wrap45(a - mean)));
-  std::printf("kitchen: Manhattan frame on %zu of %zu views; world yaw within %.2f deg of the mean\n", k_world.size(),
+  for (float a : world.yaws()) worst = std::max(worst, std::fabs(wrap45(a - mean)));
+  std::printf("kitchen: Manhattan frame on %zu of %zu views; world yaw within %.2f deg of the mean\n", world.k.size(),
               (files.size() + 9) / 10, worst / kDeg);
   EXPECT_LE(worst / kDeg, 2.5f);
 }

@@ -1,6 +1,9 @@
 #include "stairguide/perception/perception.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <opencv2/imgproc.hpp>
 
 namespace stairguide {
@@ -23,7 +26,7 @@ const char* to_string(RegionClass c) {
 Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor, const ManhattanConfig& manhattan,
                        const ClassificationConfig& classification)
     : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range),
-      classification_(classification) {}
+      classification_(classification), manhattan_cfg_(manhattan) {}
 
 Perception::Perception(const PipelineConfig& c)
     : Perception(c.segmentation, c.floor, c.manhattan, c.classification) {
@@ -34,6 +37,8 @@ Perception::Perception(const PipelineConfig& c)
 void Perception::reset() {
   floor_.reset();
   manhattan_.reset();
+  sightings_.clear();
+  last_yaw_.reset();
 }
 
 namespace {
@@ -57,6 +62,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.manhattan_why.clear();
   out.T_manhattan_floor = Pose::Identity();
   out.manhattan_yaw = out.manhattan_fraction = 0.f;
+  out.manhattan_carried = false;
+  out.manhattan_carried_age = 0.f;
   out.timings = {};
 
   std::string why;
@@ -89,6 +96,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
     if (m.found) {
       out.manhattan_yaw = m.yaw;
       out.T_manhattan_floor = m.T_manhattan_floor;
+      last_yaw_ = m.yaw;
     }
   } else {
     out.why = "no floor: " + floor_est_.why;
@@ -99,6 +107,142 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   classify_regions(out, classification_);
   out.timings.classification_ms = ms_since(t3);
   out.timings.total_ms = ms_since(t0);
+}
+
+namespace {
+constexpr float kPi = 3.14159265358979f;
+constexpr float kHalfPi = 0.5f * kPi;
+// Wraps to (-pi/4, pi/4]: the representative of a direction modulo 90 degrees.
+float wrap_quarter(float a) {
+  while (a > 0.25f * kPi) a -= kHalfPi;
+  while (a <= -0.25f * kPi) a += kHalfPi;
+  return a;
+}
+}  // namespace
+
+void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, SceneResult& out) {
+  constexpr std::size_t kMaxSightings = 128;
+  const float carry = manhattan_cfg_.carry_seconds;
+  // Another odometry world (lost track, restart), or time going backwards (another recording):
+  // the directions held are meaningless in it.
+  if (!sightings_.empty() && (odometry.track != sightings_track_ || timestamp < sightings_.back().time))
+    sightings_.clear();
+  sightings_track_ = odometry.track;
+  std::size_t stale = 0;
+  while (stale < sightings_.size() && timestamp - sightings_[stale].time > carry) ++stale;
+  sightings_.erase(sightings_.begin(), sightings_.begin() + static_cast<std::ptrdiff_t>(stale));
+  if (!out.floor_found || !(carry > 0.f)) return;
+  const Eigen::Matrix3f R_wc = odometry.T_world_camera.linear();
+  const Eigen::Matrix3f R_fc = out.T_floor_camera.linear();
+  const float sin_tol = std::sin(manhattan_cfg_.vertical_tolerance);
+  const float tol = manhattan_cfg_.cluster_tolerance;
+  const bool seen = out.manhattan_found;
+  // This view's own frame weighs what its agreeing vertical planes weigh in the estimator: area
+  // times the square of their horizontal width (a plane's yaw is as precise as it is wide).
+  float own_weight = 0.f;
+  if (seen) {
+    const Eigen::Vector3f up_c = R_fc.transpose() * Eigen::Vector3f::UnitY();
+    const float full_w = std::max(manhattan_cfg_.yaw_full_width, 1e-3f);
+    for (const PlaneRegion& r : out.regions) {
+      const Eigen::Vector3f nf = R_fc * r.normal;
+      if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
+      if (std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - out.manhattan_yaw)) > tol) continue;
+      const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
+      float lo = hz.dot(r.points.front()), hi = lo;
+      for (const Eigen::Vector3f& q : r.points) {
+        lo = std::min(lo, hz.dot(q));
+        hi = std::max(hi, hz.dot(q));
+      }
+      const float s = std::min(1.f, (hi - lo) / full_w);
+      own_weight += r.area * s * s;
+    }
+    own_weight = std::max(own_weight, 1e-6f);
+  }
+  // The held frames in this view's floor frame, fading with age (a third of carry_seconds), and
+  // this view's own. The odometry's world need not be level: the floor seen now says what is
+  // horizontal, and each direction is projected on it.
+  std::vector<HeldVote>& votes = held_votes_;
+  votes.clear();
+  const float fade = 3.f / carry;
+  for (const Sighting& sg : sightings_) {
+    Eigen::Vector3f k_f = R_fc * (R_wc.transpose() * sg.k_world);
+    k_f.y() = 0.f;
+    if (k_f.norm() < 0.5f) continue;  // not horizontal in this view: the odometry or the floor is wrong
+    votes.push_back({wrap_quarter(std::atan2(k_f.x(), k_f.z())),
+                     sg.weight * std::exp(-fade * static_cast<float>(timestamp - sg.time)), sg.time});
+  }
+  if (seen) {
+    votes.push_back({wrap_quarter(out.manhattan_yaw), own_weight, timestamp});
+    const Eigen::Vector3f k_f(std::sin(out.manhattan_yaw), 0.f, std::cos(out.manhattan_yaw));
+    if (sightings_.size() == kMaxSightings) sightings_.erase(sightings_.begin());
+    sightings_.push_back({(R_wc * (R_fc.transpose() * k_f)).normalized(), timestamp, own_weight});
+  }
+  if (votes.empty()) return;
+  // The direction most of the weight agrees on (modulo 90 degrees): the mode of a histogram of 1
+  // degree bins, refined by the circular mean of 4 * angle of the votes near it (as the estimator).
+  constexpr int kBins = 90;
+  float hist[kBins] = {};
+  for (const HeldVote& v : votes) {
+    const int bin = ((static_cast<int>((v.a + 0.25f * kPi) / kHalfPi * kBins)) % kBins + kBins) % kBins;
+    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += v.w * static_cast<float>(3 - std::abs(k));
+  }
+  const int peak = static_cast<int>(std::max_element(hist, hist + kBins) - hist);
+  const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
+  float sc = 0.f, ss = 0.f;
+  double newest = -1e300;
+  for (const HeldVote& v : votes) {
+    if (std::fabs(wrap_quarter(v.a - mode)) > tol) continue;
+    sc += v.w * std::cos(4.f * v.a);
+    ss += v.w * std::sin(4.f * v.a);
+    newest = std::max(newest, v.time);
+  }
+  float yaw = wrap_quarter(0.25f * std::atan2(ss, sc));
+  if (seen) {
+    const float off = std::fabs(wrap_quarter(out.manhattan_yaw - yaw));
+    if (off <= tol) {
+      // The view agrees with what is held: the frame reported is the weighted mean of both, on
+      // the view's own branch. One view's yaw is off by degrees on real walls (the kitchen's spread
+      // 5.9 deg view by view, 2.4 deg held); the odometry's drift over seconds is far less.
+      const float y = out.manhattan_yaw + wrap_quarter(yaw - out.manhattan_yaw);
+      out.manhattan_yaw = y;
+      out.T_manhattan_floor = manhattan_pose_from_yaw(y);
+      last_yaw_ = y;
+      return;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "this view's planes made a frame %.1f deg off the one held in the world, and weigh less: kept "
+                  "the held one",
+                  off * 180.f / kPi);
+    out.manhattan_why = buf;
+  }
+  // k_M is the dominant direction closest to forward (modulo 90 degrees), kept on the branch last
+  // reported near +-45 degrees, as ManhattanTracker does for the frames it sees.
+  if (last_yaw_) {
+    float best = yaw;
+    for (int k = -1; k <= 1; k += 2) {
+      const float c = yaw + static_cast<float>(k) * kHalfPi;
+      if (std::fabs(c - *last_yaw_) < std::fabs(best - *last_yaw_)) best = c;
+    }
+    if (std::fabs(best) < 0.25f * kPi + 0.1745f) yaw = best;  // 10 degrees of hysteresis
+  }
+  // Share of the planar area on vertical planes along the axes reported (the same measure the
+  // estimator reports): stair modelling asks for its own share before it uses a frame.
+  float total = 0.f, agree = 0.f;
+  for (const PlaneRegion& r : out.regions) {
+    total += r.area;
+    const Eigen::Vector3f nf = R_fc * r.normal;
+    if (std::fabs(nf.y()) <= sin_tol && std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - yaw)) <= tol)
+      agree += r.area;
+  }
+  out.manhattan_found = true;
+  out.manhattan_carried = true;
+  out.manhattan_carried_age = static_cast<float>(timestamp - newest);
+  out.manhattan_yaw = yaw;
+  out.T_manhattan_floor = manhattan_pose_from_yaw(yaw);
+  out.manhattan_fraction = total > 0.f ? agree / total : 0.f;
+  last_yaw_ = yaw;
+  classify_regions(out, classification_);  // left / right / front against the axes reported
 }
 
 cv::Vec3b region_class_color(RegionClass c) {

@@ -73,8 +73,9 @@ std::string OdometryStage::describe() const { return "DenseOdometry"; }
 
 // ---------------------------------------------------------------------------------------------
 // Perception (segmentation, floor, Manhattan, classification) -> stairs (detection, modelling).
+// The odometry's pose of the same frame carries the Manhattan frame between views.
 // SEAM (traversal): the library has no traversal stage yet (paper 5.2: step counting with the
-// odometry pose); `T_world_camera` is handed in for it and unused until it lands.
+// odometry pose).
 struct PerceptionStage::Impl {
   explicit Impl(const PipelineConfig& c) : config(c), perception(c), stairs(c) {}
   PipelineConfig config;
@@ -87,14 +88,24 @@ struct PerceptionStage::Impl {
 PerceptionStage::PerceptionStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
 PerceptionStage::~PerceptionStage() = default;
 
-PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const Pose* /*T_world_camera*/) {
+PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const OdometryLookup& odometry) {
   const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   m.perception.process(frame, m.scene);
+  // Asked for only now: the odometry, running beside perception on the same frame, has usually
+  // finished it by the time segmentation has. Perception waits for it only on a view that needs
+  // a frame carried; a view's own frame not kept for want of its pose leaves the one kept before.
+  OdometryLink link;
+  const bool carry =
+      !m.scene.manhattan_found && m.scene.floor_found && m.perception.can_carry_manhattan(frame.timestamp);
+  if (odometry && odometry(link, carry)) m.perception.apply_odometry(link, frame.timestamp, m.scene);
   PerceptionOutput out;
   out.seq = frame.index;
   out.ran = true;
   out.floor_found = m.scene.floor_found;
+  out.manhattan_found = m.scene.manhattan_found;
+  out.manhattan_carried = m.scene.manhattan_carried;
+  out.manhattan_yaw = m.scene.manhattan_yaw;
   // The stair stage runs without a floor too: its floorless route (when configured) finds a stack
   // of treads by their own vertical, with the distance from the user's feet unknown.
   m.stairs.run(m.scene, &frame.intrinsics, m.stair);

@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
@@ -17,6 +18,7 @@
 #include <mutex>
 #include <thread>
 
+#include "stairguide/perception/perception.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/logging.hpp"
 #include "stairguide/runtime/pipeline.hpp"
@@ -186,10 +188,22 @@ struct Runtime::Impl {
   Clock::time_point first_capture{}, last_decision{};
   bool have_first = false, have_last = false;
 
-  // ---- latest pose, odometry -> perception ----
+  // ---- odometry poses by frame, odometry -> perception ----
+  // Perception carries the Manhattan frame between views with the pose of the very frame it works
+  // on (a pose a few frames old is degrees off in a turn); the odometry runs beside it on the same
+  // frame, so the last kPoseLog poses are kept by frame number.
+  struct PoseEntry {
+    std::uint64_t seq = ~std::uint64_t{0};
+    Pose T_world_camera = Pose::Identity();
+    std::uint64_t track = 0;  // changes when the odometry's world does (a failure, a restart)
+    bool ok = false;
+  };
+  static constexpr std::size_t kPoseLog = 64;
   std::mutex pose_mutex;
-  bool have_pose = false;
-  Pose latest_pose = Pose::Identity();
+  std::condition_variable pose_cv;
+  std::array<PoseEntry, kPoseLog> pose_log{};
+  std::uint64_t odo_track = 0;
+  std::uint64_t odo_next_seq = 0;  // every frame before this one has passed the odometry
 
   // ---- capture state (capture thread, or the caller in synchronous mode) ----
   std::uint64_t next_seq = 0;
@@ -441,9 +455,15 @@ struct Runtime::Impl {
     if (m.out.ran && !m.out.ok) odo_failures.fetch_add(1);
     add_atomic(odo_ms_sum, m.out.ms);
     if (m.out.ran) {
-      std::lock_guard<std::mutex> lk(pose_mutex);
-      latest_pose = m.out.T_world_camera;
-      have_pose = true;
+      {
+        std::lock_guard<std::mutex> lk(pose_mutex);
+        // A restart begins a new world; a failed frame's pose is a guess, and what follows it is
+        // not known to be in the same world as what came before.
+        if (p.new_track || !m.out.ok) ++odo_track;
+        pose_log[p.seq % kPoseLog] = {p.seq, m.out.T_world_camera, odo_track, m.out.ok};
+        odo_next_seq = std::max(odo_next_seq, p.seq + 1);
+      }
+      pose_cv.notify_all();
     }
     return m;
   }
@@ -487,18 +507,29 @@ struct Runtime::Impl {
 
   // ================================ perception ================================
 
-  PercMsg run_perception(const FramePacket& p, std::uint64_t gen) {
-    Pose pose;
-    bool with_pose = false;
-    {
-      std::lock_guard<std::mutex> lk(pose_mutex);
-      if (have_pose) {
-        pose = latest_pose;
-        with_pose = true;
+  /// The odometry's trusted pose of frame `seq`, with `wait` waiting up to kPoseWait for the
+  /// odometry thread to reach it; false when it failed on it, dropped it, has not reached it, or
+  /// has stopped.
+  static constexpr Ms kPoseWait{100};
+  bool odometry_pose_of(std::uint64_t seq, OdometryLink& link, bool wait) {
+    std::unique_lock<std::mutex> lk(pose_mutex);
+    const auto deadline = Clock::now() + kPoseWait;
+    for (;;) {
+      const PoseEntry& e = pose_log[seq % kPoseLog];
+      if (e.seq == seq) {
+        if (!e.ok) return false;
+        link.T_world_camera = e.T_world_camera;
+        link.track = e.track;
+        return true;
       }
+      if (!wait || odo_next_seq > seq || done[kOdometry].load() || stop.load()) return false;
+      if (pose_cv.wait_until(lk, deadline) == std::cv_status::timeout) return false;
     }
+  }
+
+  PercMsg run_perception(const FramePacket& p, std::uint64_t gen) {
     PercMsg m;
-    m.out = perception->step(*p.frame, with_pose ? &pose : nullptr);
+    m.out = perception->step(*p.frame, [this, seq = p.seq](OdometryLink& link, bool wait) { return odometry_pose_of(seq, link, wait); });
     m.out.seq = p.seq;
     m.timestamp = p.frame->timestamp;
     m.captured = p.captured;
@@ -610,9 +641,10 @@ struct Runtime::Impl {
     if (o) std::snprintf(oms, sizeof oms, "%.2f", o->out.ms);
     std::fprintf(
         opt.frame_out,
-        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s\n",
+        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s\n",
         static_cast<unsigned long long>(seq), ts, odom.c_str(), p ? token(p->out.state).c_str() : "skipped",
-        static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms);
+        static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms,
+        !p ? "-" : !p->out.manhattan_found ? "none" : p->out.manhattan_carried ? "carried" : "seen");
     std::fflush(opt.frame_out);
   }
 

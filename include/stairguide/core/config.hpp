@@ -203,6 +203,7 @@ struct ManhattanConfig {
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
   float clipped_disagreement = 0.2617994f;  ///< rad, ... and contradicts another direction only beyond this (15 deg)
+  float carry_seconds = 10.f;         ///< s, a Manhattan frame seen this recently is carried by the odometry to views that make none (0: never)
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -240,6 +241,9 @@ struct ManhattanConfig {
     v.num(clipped_disagreement, "clipped_disagreement_deg", Unit::kDegree, 0.5, 45,
           "a sliver contradicts another direction, modulo 90 deg, only when it differs by more than this (other "
           "planes: cluster_tolerance)");
+    v.num(carry_seconds, "carry_s", Unit::kSecond, 0, 600,
+          "seconds a Manhattan frame seen in one view is carried by the odometry to later views whose own walls make "
+          "none (walls do not turn when the user does); 0: never");
   }
 };
 

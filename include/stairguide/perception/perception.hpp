@@ -4,6 +4,10 @@
 /// classification in order on one RGB-D frame, with the floor and Manhattan tracking kept between
 /// frames. Pure: no threads, no I/O, no exceptions on the per-frame path; buffers are kept.
 
+#include <cstdint>
+#include <optional>
+#include <vector>
+
 #include "stairguide/core/config.hpp"
 #include "stairguide/perception/floor_detection.hpp"
 #include "stairguide/perception/manhattan_frame.hpp"
@@ -12,6 +16,15 @@
 #include "stairguide/perception/segmentation.hpp"
 
 namespace stairguide {
+
+/// The odometry's pose of the frame being processed, for what perception keeps in the world from
+/// one frame to the next (the Manhattan frame: walls do not turn when the user does).
+struct OdometryLink {
+  Pose T_world_camera = Pose::Identity();  ///< this frame's camera in the odometry's world
+  /// Changes whenever the odometry's world is not the one of the previous poses (tracking lost, a
+  /// restart, a new recording): nothing is carried across a change.
+  std::uint64_t track = 0;
+};
 
 class Perception {
  public:
@@ -28,6 +41,30 @@ class Perception {
     return r;
   }
 
+  /// With the odometry's pose of the frame `out` was just computed from (process()): the Manhattan
+  /// frame is held in the odometry's world, where walls do not turn when the user does. Every frame
+  /// a view sees is kept there for ManhattanConfig::carry_seconds with the weight of the planes
+  /// that made it (area times squared width, fading with age); the frame held is the direction
+  /// most of that weight agrees on, this view's own included.
+  /// - A view whose own frame agrees with the held one (within cluster_tolerance) reports their
+  ///   weighted mean: one view's yaw is off by degrees on real walls, the odometry's drift over
+  ///   seconds much less.
+  /// - A view whose own planes make no frame (a strip of wall while turning) gets the held one.
+  /// - A view whose own frame turns against the held one by more than cluster_tolerance (a box
+  ///   at the edge of the view taken for a wall) gets the held one, unless its own planes outweigh
+  ///   what is held.
+  /// Either way out.manhattan_carried is set, manhattan_why says why, and the vertical regions are
+  /// classified again against the frame reported. Nothing is held across a change of the
+  /// odometry's track. Call it for the frames in order; a frame it is not called for neither adds
+  /// to nor gets the held frame.
+  void apply_odometry(const OdometryLink& odometry, double timestamp, SceneResult& out);
+  /// A frame is held that a view at `timestamp` could be given (if the odometry's track has not
+  /// changed since).
+  bool can_carry_manhattan(double timestamp) const {
+    return !sightings_.empty() && timestamp >= sightings_.back().time &&
+           timestamp - sightings_.back().time <= manhattan_cfg_.carry_seconds;
+  }
+
   /// Forgets the floor and Manhattan tracking (start of a new sequence, or independent views).
   void reset();
 
@@ -42,6 +79,21 @@ class Perception {
   ManhattanTracker manhattan_;
   ClassificationConfig classification_;
   FloorEstimate floor_est_;
+  ManhattanConfig manhattan_cfg_;
+  // Manhattan frames seen in recent views: k_M in the odometry's world, time, weight.
+  struct Sighting {
+    Eigen::Vector3f k_world;
+    double time;
+    float weight;
+  };
+  std::vector<Sighting> sightings_;  // oldest first
+  struct HeldVote {
+    float a, w;  // rad modulo 90 degrees in this view's floor frame; weight
+    double time;
+  };
+  std::vector<HeldVote> held_votes_;  // scratch
+  std::uint64_t sightings_track_ = 0;
+  std::optional<float> last_yaw_;  // the last yaw reported (seen or carried): keeps k_M's branch
 };
 
 /// Colours of the paper's Fig. 3 f (BGR): yellow vertical, blue horizontal step candidate, green

@@ -87,6 +87,11 @@ struct SceneResult {
   Pose T_manhattan_floor = Pose::Identity();  ///< floor frame into Manhattan frame M (rotation about y)
   float manhattan_yaw = 0.f;              ///< rad, angle of k_M from z_F about y_F
   float manhattan_fraction = 0.f;         ///< share of points on Manhattan-aligned vertical planes
+  /// The frame reported is the one held in the world from earlier views, carried by the odometry
+  /// (Perception::apply_odometry): this view's own planes made none, or one that the held frame
+  /// outweighs; manhattan_why says which.
+  bool manhattan_carried = false;
+  float manhattan_carried_age = 0.f;      ///< s since a view last saw the frame carried
 
   std::vector<PlaneRegion> regions;
   std::vector<ObstacleCluster> clusters;

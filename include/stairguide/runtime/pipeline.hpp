@@ -4,7 +4,7 @@
 /// the synchronous (one thread, in order) mode drive exactly the same code.
 ///
 /// - `OdometryStage::step(frame)`: dense RGB-D odometry on every frame (odometry room).
-/// - `PerceptionStage::step(frame, pose)`: segmentation, floor, Manhattan frame, classification
+/// - `PerceptionStage::step(frame, odometry)`: segmentation, floor, Manhattan frame, classification
 ///   (perception room) -> stair detection and modelling (stairs room) -> traversal.
 /// - `FeedbackStage::decide(perception, odometry)`: the cue decision (feedback room).
 ///
@@ -14,11 +14,16 @@
 /// between two frames.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "stairguide/core/config.hpp"
 #include "stairguide/core/types.hpp"
+
+namespace stairguide {
+struct OdometryLink;  // perception/perception.hpp
+}
 
 namespace stairguide::runtime {
 
@@ -43,8 +48,18 @@ struct PerceptionOutput {
   std::string state;
   std::string detail;  ///< human-readable: why no floor / no stair, levels, riser...
   int levels = 0;      ///< stair levels in view (0 without a detection)
+  /// The Manhattan frame: seen in this view, carried by the odometry from an earlier one, or none.
+  bool manhattan_found = false;
+  bool manhattan_carried = false;
+  float manhattan_yaw = 0.f;  ///< rad, k_M from the floor frame's forward axis
   double ms = 0.0;     ///< time spent in the stages
 };
+
+/// Fills `link` with the odometry's trusted pose of the frame perception is working on, and
+/// returns true; false when there is none (odometry failed on it, dropped it, has not reached it,
+/// or is not running). With `wait` it may wait briefly for the odometry thread to reach the frame
+/// (asked only where a Manhattan frame is to be carried: elsewhere perception does not wait).
+using OdometryLookup = std::function<bool(OdometryLink& link, bool wait)>;
 
 /// The feedback decision for one perceived frame.
 struct Decision {
@@ -82,8 +97,9 @@ class PerceptionStage {
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
 
-  /// `T_world_camera` is the latest odometry pose (possibly of an earlier frame), or null.
-  PerceptionOutput step(const RgbdFrame& frame, const Pose* T_world_camera);
+  /// `odometry` gives the odometry's pose of this same frame (may be empty): the Manhattan frame
+  /// is kept in the odometry's world and carried to views whose own walls make none.
+  PerceptionOutput step(const RgbdFrame& frame, const OdometryLookup& odometry);
   void reconfigure(const PipelineConfig& config);
   bool available() const;
   std::string describe() const;
