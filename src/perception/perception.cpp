@@ -120,8 +120,55 @@ float wrap_quarter(float a) {
 }
 }  // namespace
 
-void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, SceneResult& out) {
+ManhattanSighting Perception::manhattan_sighting(const SceneResult& out, double timestamp) const {
+  ManhattanSighting sg;
+  if (!out.floor_found || !out.manhattan_found || out.manhattan_carried) return sg;
+  const Eigen::Matrix3f R_fc = out.T_floor_camera.linear();
+  const float sin_tol = std::sin(manhattan_cfg_.vertical_tolerance);
+  // The view's frame weighs what its agreeing vertical planes weigh in the estimator: area times
+  // the square of their horizontal width (a plane's yaw is as precise as it is wide).
+  const Eigen::Vector3f up_c = R_fc.transpose() * Eigen::Vector3f::UnitY();
+  const float full_w = std::max(manhattan_cfg_.yaw_full_width, 1e-3f);
+  float weight = 0.f;
+  for (const PlaneRegion& r : out.regions) {
+    const Eigen::Vector3f nf = R_fc * r.normal;
+    if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
+    if (std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - out.manhattan_yaw)) > manhattan_cfg_.cluster_tolerance)
+      continue;
+    const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
+    float lo = hz.dot(r.points.front()), hi = lo;
+    for (const Eigen::Vector3f& q : r.points) {
+      lo = std::min(lo, hz.dot(q));
+      hi = std::max(hi, hz.dot(q));
+    }
+    const float s = std::min(1.f, (hi - lo) / full_w);
+    weight += r.area * s * s;
+  }
+  sg.valid = true;
+  sg.k_camera = R_fc.transpose() * Eigen::Vector3f(std::sin(out.manhattan_yaw), 0.f, std::cos(out.manhattan_yaw));
+  sg.weight = std::max(weight, 1e-6f);
+  sg.timestamp = timestamp;
+  return sg;
+}
+
+void Perception::hold_manhattan(const ManhattanSighting& sighting, const OdometryLink& odometry) {
   constexpr std::size_t kMaxSightings = 128;
+  if (!sighting.valid || !(manhattan_cfg_.carry_seconds > 0.f)) return;
+  if (!sightings_.empty() && odometry.track != sightings_track_) {
+    if (sighting.timestamp < sightings_.back().time) return;  // a late one from the old world
+    sightings_.clear();
+  }
+  sightings_track_ = odometry.track;
+  if (sightings_.size() == kMaxSightings) sightings_.erase(sightings_.begin());
+  const Sighting held{(odometry.T_world_camera.linear() * sighting.k_camera).normalized(), sighting.timestamp,
+                      sighting.weight};
+  // In time order: a view whose pose came late goes before the ones held since.
+  auto at = sightings_.end();
+  while (at != sightings_.begin() && (at - 1)->time > held.time) --at;
+  sightings_.insert(at, held);
+}
+
+void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, SceneResult& out) {
   const float carry = manhattan_cfg_.carry_seconds;
   // Another odometry world (lost track, restart), or time going backwards (another recording):
   // the directions held are meaningless in it.
@@ -136,28 +183,8 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
   const Eigen::Matrix3f R_fc = out.T_floor_camera.linear();
   const float sin_tol = std::sin(manhattan_cfg_.vertical_tolerance);
   const float tol = manhattan_cfg_.cluster_tolerance;
-  const bool seen = out.manhattan_found;
-  // This view's own frame weighs what its agreeing vertical planes weigh in the estimator: area
-  // times the square of their horizontal width (a plane's yaw is as precise as it is wide).
-  float own_weight = 0.f;
-  if (seen) {
-    const Eigen::Vector3f up_c = R_fc.transpose() * Eigen::Vector3f::UnitY();
-    const float full_w = std::max(manhattan_cfg_.yaw_full_width, 1e-3f);
-    for (const PlaneRegion& r : out.regions) {
-      const Eigen::Vector3f nf = R_fc * r.normal;
-      if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
-      if (std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - out.manhattan_yaw)) > tol) continue;
-      const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
-      float lo = hz.dot(r.points.front()), hi = lo;
-      for (const Eigen::Vector3f& q : r.points) {
-        lo = std::min(lo, hz.dot(q));
-        hi = std::max(hi, hz.dot(q));
-      }
-      const float s = std::min(1.f, (hi - lo) / full_w);
-      own_weight += r.area * s * s;
-    }
-    own_weight = std::max(own_weight, 1e-6f);
-  }
+  const ManhattanSighting own = manhattan_sighting(out, timestamp);
+  const bool seen = own.valid;
   // The held frames in this view's floor frame, fading with age (a third of carry_seconds), and
   // this view's own. The odometry's world need not be level: the floor seen now says what is
   // horizontal, and each direction is projected on it.
@@ -172,10 +199,8 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
                      sg.weight * std::exp(-fade * static_cast<float>(timestamp - sg.time)), sg.time});
   }
   if (seen) {
-    votes.push_back({wrap_quarter(out.manhattan_yaw), own_weight, timestamp});
-    const Eigen::Vector3f k_f(std::sin(out.manhattan_yaw), 0.f, std::cos(out.manhattan_yaw));
-    if (sightings_.size() == kMaxSightings) sightings_.erase(sightings_.begin());
-    sightings_.push_back({(R_wc * (R_fc.transpose() * k_f)).normalized(), timestamp, own_weight});
+    votes.push_back({wrap_quarter(out.manhattan_yaw), own.weight, timestamp});
+    hold_manhattan(own, odometry);
   }
   if (votes.empty()) return;
   // The direction most of the weight agrees on (modulo 90 degrees): the mode of a histogram of 1
@@ -202,7 +227,7 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
     if (off <= tol) {
       // The view agrees with what is held: the frame reported is the weighted mean of both, on
       // the view's own branch. One view's yaw is off by degrees on real walls (the kitchen's spread
-      // 5.9 deg view by view, 2.4 deg held); the odometry's drift over seconds is far less.
+      // 6.2 deg view by view, 2.2 deg held); the odometry's drift over seconds is far less.
       const float y = out.manhattan_yaw + wrap_quarter(yaw - out.manhattan_yaw);
       out.manhattan_yaw = y;
       out.T_manhattan_floor = manhattan_pose_from_yaw(y);

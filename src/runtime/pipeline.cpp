@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <deque>
+#include <utility>
 
 #include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/perception/perception.hpp"
@@ -83,22 +85,18 @@ struct PerceptionStage::Impl {
   StairStage stairs;
   SceneResult scene;
   StairResult stair;
+  // Views whose own Manhattan frame waits for the odometry's pose of their frame (oldest first).
+  std::deque<std::pair<std::uint64_t, ManhattanSighting>> pending;
 };
 
 PerceptionStage::PerceptionStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
 PerceptionStage::~PerceptionStage() = default;
 
-PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const OdometryLookup& odometry) {
+PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry) {
   const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   m.perception.process(frame, m.scene);
-  // Asked for only now: the odometry, running beside perception on the same frame, has usually
-  // finished it by the time segmentation has. Perception waits for it only on a view that needs
-  // a frame carried; a view's own frame not kept for want of its pose leaves the one kept before.
-  OdometryLink link;
-  const bool carry =
-      !m.scene.manhattan_found && m.scene.floor_found && m.perception.can_carry_manhattan(frame.timestamp);
-  if (odometry && odometry(link, carry)) m.perception.apply_odometry(link, frame.timestamp, m.scene);
+  if (odometry) hold_and_carry(frame, seq, odometry);
   PerceptionOutput out;
   out.seq = frame.index;
   out.ran = true;
@@ -134,6 +132,36 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, const OdometryLoo
   out.ms = ms_since(t0);
   return out;
 }
+// The odometry's pose is asked for only now: running beside perception on the same frame, it has
+// usually finished the frame by the time segmentation has. Perception waits for it only on a view
+// that needs a frame carried; a view seen before its pose came is held when the pose comes.
+void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry) {
+  constexpr std::size_t kMaxPending = 32;
+  Impl& m = *impl_;
+  auto flush = [&] {
+    while (!m.pending.empty()) {
+      OdometryLink l;
+      const PoseAnswer a = odometry(m.pending.front().first, l, false);
+      if (a == PoseAnswer::kNotYet) break;  // nor the later ones: the odometry goes in order
+      if (a == PoseAnswer::kReady) m.perception.hold_manhattan(m.pending.front().second, l);
+      m.pending.pop_front();
+    }
+  };
+  flush();
+  const ManhattanSighting own = m.perception.manhattan_sighting(m.scene, frame.timestamp);
+  const bool carry = !own.valid && m.scene.floor_found &&
+                     (m.perception.can_carry_manhattan(frame.timestamp) || !m.pending.empty());
+  OdometryLink link;
+  const PoseAnswer a = odometry(seq, link, carry);
+  if (a == PoseAnswer::kReady) {
+    flush();  // the odometry has passed the views before this one
+    m.perception.apply_odometry(link, frame.timestamp, m.scene);
+  } else if (a == PoseAnswer::kNotYet && own.valid) {
+    if (m.pending.size() == kMaxPending) m.pending.pop_front();
+    m.pending.emplace_back(seq, own);
+  }
+}
+
 void PerceptionStage::reconfigure(const PipelineConfig& config) {
   // The stages take their config at construction; tracking restarts with the new values.
   impl_ = std::make_unique<Impl>(config);

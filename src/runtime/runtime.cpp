@@ -204,6 +204,7 @@ struct Runtime::Impl {
   std::array<PoseEntry, kPoseLog> pose_log{};
   std::uint64_t odo_track = 0;
   std::uint64_t odo_next_seq = 0;  // every frame before this one has passed the odometry
+  bool odo_restarted = false;      // odometry thread only: reconfigured, its next frame starts afresh
 
   // ---- capture state (capture thread, or the caller in synchronous mode) ----
   std::uint64_t next_seq = 0;
@@ -457,9 +458,11 @@ struct Runtime::Impl {
     if (m.out.ran) {
       {
         std::lock_guard<std::mutex> lk(pose_mutex);
-        // A restart begins a new world; a failed frame's pose is a guess, and what follows it is
-        // not known to be in the same world as what came before.
-        if (p.new_track || !m.out.ok) ++odo_track;
+        // A restart (a new track, a new config) begins a new world: the motion up to its first
+        // frame is not measured. A failed frame's pose is a guess, and what follows it is not
+        // known to be in the same world as what came before.
+        if (p.new_track || odo_restarted || !m.out.ok) ++odo_track;
+        odo_restarted = false;
         pose_log[p.seq % kPoseLog] = {p.seq, m.out.T_world_camera, odo_track, m.out.ok};
         odo_next_seq = std::max(odo_next_seq, p.seq + 1);
       }
@@ -497,7 +500,10 @@ struct Runtime::Impl {
         continue;
       }
       odo_in_space.ring();
-      apply_config(gen, [&](const PipelineConfig& c) { odometry->reconfigure(c); });
+      apply_config(gen, [&](const PipelineConfig& c) {
+        odometry->reconfigure(c);
+        odo_restarted = true;
+      });
       OdoMsg m = run_odometry(p);
       p.frame.reset();
       push_result(*odo_out, m, kOdometry);
@@ -508,28 +514,30 @@ struct Runtime::Impl {
   // ================================ perception ================================
 
   /// The odometry's trusted pose of frame `seq`, with `wait` waiting up to kPoseWait for the
-  /// odometry thread to reach it; false when it failed on it, dropped it, has not reached it, or
-  /// has stopped.
+  /// odometry thread to reach it.
   static constexpr Ms kPoseWait{100};
-  bool odometry_pose_of(std::uint64_t seq, OdometryLink& link, bool wait) {
+  PoseAnswer odometry_pose_of(std::uint64_t seq, OdometryLink& link, bool wait) {
     std::unique_lock<std::mutex> lk(pose_mutex);
     const auto deadline = Clock::now() + kPoseWait;
     for (;;) {
       const PoseEntry& e = pose_log[seq % kPoseLog];
       if (e.seq == seq) {
-        if (!e.ok) return false;
+        if (!e.ok) return PoseAnswer::kNever;
         link.T_world_camera = e.T_world_camera;
         link.track = e.track;
-        return true;
+        return PoseAnswer::kReady;
       }
-      if (!wait || odo_next_seq > seq || done[kOdometry].load() || stop.load()) return false;
-      if (pose_cv.wait_until(lk, deadline) == std::cv_status::timeout) return false;
+      // Passed (dropped, or so long ago that the log has moved on), or no odometry any more.
+      if (odo_next_seq > seq || done[kOdometry].load() || stop.load()) return PoseAnswer::kNever;
+      if (!wait || pose_cv.wait_until(lk, deadline) == std::cv_status::timeout) return PoseAnswer::kNotYet;
     }
   }
 
   PercMsg run_perception(const FramePacket& p, std::uint64_t gen) {
     PercMsg m;
-    m.out = perception->step(*p.frame, [this, seq = p.seq](OdometryLink& link, bool wait) { return odometry_pose_of(seq, link, wait); });
+    m.out = perception->step(*p.frame, p.seq, [this](std::uint64_t seq, OdometryLink& link, bool wait) {
+      return odometry_pose_of(seq, link, wait);
+    });
     m.out.seq = p.seq;
     m.timestamp = p.frame->timestamp;
     m.captured = p.captured;
@@ -903,6 +911,7 @@ int Runtime::run() {
     if (m.get_state() == State::kStarting) m.set_state(State::kRunning);
     m.apply_config(gen, [&](const PipelineConfig& c) {
       m.odometry->reconfigure(c);
+      m.odo_restarted = true;
       m.perception->reconfigure(c);
       m.feedback->reconfigure(c);
     });

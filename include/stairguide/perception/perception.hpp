@@ -26,6 +26,15 @@ struct OdometryLink {
   std::uint64_t track = 0;
 };
 
+/// One view's own Manhattan frame, to be held in the odometry's world once the odometry's pose of
+/// that view's frame is known (it may come a few frames later: the odometry runs beside).
+struct ManhattanSighting {
+  bool valid = false;
+  Eigen::Vector3f k_camera = Eigen::Vector3f::UnitZ();  ///< k_M in the view's camera frame
+  float weight = 0.f;      ///< its agreeing vertical planes: area times squared horizontal width
+  double timestamp = 0.0;  ///< s, the view's
+};
+
 class Perception {
  public:
   Perception(const SegmentationConfig& seg = {}, const FloorConfig& floor = {}, const ManhattanConfig& manhattan = {},
@@ -54,10 +63,18 @@ class Perception {
   ///   at the edge of the view taken for a wall) gets the held one, unless its own planes outweigh
   ///   what is held.
   /// Either way out.manhattan_carried is set, manhattan_why says why, and the vertical regions are
-  /// classified again against the frame reported. Nothing is held across a change of the
-  /// odometry's track. Call it for the frames in order; a frame it is not called for neither adds
-  /// to nor gets the held frame.
+  /// classified again against the frame reported; this view's own frame is then held (as
+  /// hold_manhattan). Nothing is held across a change of the odometry's track. Call it for the
+  /// frames in order; a frame it is not called for neither gets the held frame nor adds to it
+  /// (unless its sighting is held later with hold_manhattan).
   void apply_odometry(const OdometryLink& odometry, double timestamp, SceneResult& out);
+  /// The frame `out` (just computed by process(), at `timestamp`) made of its own; invalid when
+  /// none. Taken before apply_odometry changes `out`.
+  ManhattanSighting manhattan_sighting(const SceneResult& out, double timestamp) const;
+  /// Holds a view's own frame, given the odometry's pose of that view's frame: for a view whose
+  /// pose came only after later views (apply_odometry holds the frame of the view it is given).
+  /// A sighting from another track than the frames held, older than them, is dropped.
+  void hold_manhattan(const ManhattanSighting& sighting, const OdometryLink& odometry);
   /// A frame is held that a view at `timestamp` could be given (if the odometry's track has not
   /// changed since).
   bool can_carry_manhattan(double timestamp) const {
@@ -86,7 +103,7 @@ class Perception {
     double time;
     float weight;
   };
-  std::vector<Sighting> sightings_;  // oldest first
+  std::vector<Sighting> sightings_;  // oldest first (by the views' time)
   struct HeldVote {
     float a, w;  // rad modulo 90 degrees in this view's floor frame; weight
     double time;

@@ -55,11 +55,16 @@ struct PerceptionOutput {
   double ms = 0.0;     ///< time spent in the stages
 };
 
-/// Fills `link` with the odometry's trusted pose of the frame perception is working on, and
-/// returns true; false when there is none (odometry failed on it, dropped it, has not reached it,
-/// or is not running). With `wait` it may wait briefly for the odometry thread to reach the frame
-/// (asked only where a Manhattan frame is to be carried: elsewhere perception does not wait).
-using OdometryLookup = std::function<bool(OdometryLink& link, bool wait)>;
+/// What the odometry says of a frame's pose.
+enum class PoseAnswer {
+  kReady,   ///< `link` holds its trusted pose
+  kNotYet,  ///< the odometry has not reached the frame yet
+  kNever,   ///< there will be none: the odometry failed on it, dropped it, or has stopped
+};
+/// The odometry's pose of runtime frame `seq`. With `wait` it may wait briefly for the odometry
+/// thread to reach the frame (asked only where a Manhattan frame is to be carried: elsewhere
+/// perception does not wait).
+using OdometryLookup = std::function<PoseAnswer(std::uint64_t seq, OdometryLink& link, bool wait)>;
 
 /// The feedback decision for one perceived frame.
 struct Decision {
@@ -97,14 +102,17 @@ class PerceptionStage {
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
 
-  /// `odometry` gives the odometry's pose of this same frame (may be empty): the Manhattan frame
-  /// is kept in the odometry's world and carried to views whose own walls make none.
-  PerceptionOutput step(const RgbdFrame& frame, const OdometryLookup& odometry);
+  /// `seq` is the runtime frame number of `frame`; `odometry` gives the odometry's poses by frame
+  /// number (may be empty): the Manhattan frame is held in the odometry's world and carried to
+  /// views whose own walls make none. A view whose pose is not there yet has its frame held when
+  /// it comes, on a later step.
+  PerceptionOutput step(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry);
   void reconfigure(const PipelineConfig& config);
   bool available() const;
   std::string describe() const;
 
  private:
+  void hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
