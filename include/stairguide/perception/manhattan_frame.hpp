@@ -18,7 +18,6 @@
 
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "stairguide/core/config.hpp"
@@ -58,8 +57,11 @@ class ManhattanTracker {
     bool grounded;  // its lowest point is at the floor's height
     bool clipped;   // most of its points lie at the depth cut-off
     int region;     // index in the regions
-    bool backed;    // inside, or any other surface (a countertop, a seat, treads, a wall) lies beyond it
     bool sliver;    // clipped, and narrower than ManhattanConfig::sliver_width: its yaw may be off by 10 degrees
+    // Its plane seen from above, normal towards the camera: a point (x, z) of the floor frame lies
+    // beyond it by more than floor_beyond_margin when nx * x + nz * z < limit.
+    bool has_side = false;
+    float nx = 0.f, nz = 0.f, limit = 0.f;
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
@@ -79,9 +81,7 @@ class ManhattanTracker {
   std::vector<Vote> votes_;               // scratch
   std::vector<FloorSample> floor_pts_;    // scratch
   std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
-  std::vector<int> vote_of_region_;          // scratch: vote index of each region, -1 if not vertical
-  std::vector<float> beyond_by_region_;      // scratch: m^2 of each region beyond one plane
-  std::vector<std::pair<int, int>> beyond_pairs_;  // scratch: (plane, disagreeing vertical plane beyond it)
+  std::vector<std::size_t> region_samples_;  // scratch: region k's samples start at [k], end at [k + 1]
 };
 
 }  // namespace stairguide
