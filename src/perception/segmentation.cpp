@@ -705,46 +705,69 @@ void Segmentation::split_border_bands(std::vector<Grow>& grows) {
       bins_[static_cast<std::size_t>(slot[l]) * K + v].add(un_[u], vn_[v], w_[v * W_ + u]);
     }
   }
-  // A crease (a tread above its riser: 90 degrees); oblique directions of clutter do not count.
-  const float cos_pair = std::cos(60.f * 3.14159265f / 180.f);
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const int r = regs[i];
+    const BandSplit best = best_band_split(grows[r], &bins_[i * K], /*below_edge=*/false);
+    if (best.dir < 0) continue;
+    std::vector<int>& pix = split_pixels_;
+    pix.clear();
+    for (int v = 0; v < best.rows; ++v)
+      for (int u = 0; u < W_; ++u)
+        if (label_[v * W_ + u] == r) pix.push_back(v * W_ + u);
+    if (!move_to_new_region(grows, r, pix, best.dir)) continue;
+    refit_region(grows[r]);
+    ++stats_.border_splits;
+  }
+}
+
+Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDepthMoments* bins,
+                                                      bool below_edge) const {
+  // The band is the region's first k rows from the border or the edge (bins[0..k)), for each k up
+  // to kBorderBandRows; it is split off onto a dominant direction when that explains the region
+  // better than its one plane by kSplitGain noise sigmas.
+  const int K = kBorderBandRows;
+  // The direction a tread sliver may take against its riser's plane: square to it within 15
+  // degrees below an edge (the edges found there are many, keep to treads); at the border any
+  // crease of 60 degrees or more (oblique directions of clutter do not count).
+  const float max_cos = below_edge ? std::sin(15.f * 3.14159265f / 180.f) : std::cos(60.f * 3.14159265f / 180.f);
   const float limit = 0.5f * tolerance_w();
   const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
   const int nd = static_cast<int>(dirs_.size());
-  for (std::size_t i = 0; i < regs.size(); ++i) {
-    const int r = regs[i];
-    const Grow& g = grows[r];
-    const double ssr_joint = g.m.n * InvDepthMomentsMsr(g.m, g.plane.a, g.plane.b, g.plane.c);
-    double best = ssr_joint;
-    int best_k = 0, best_d = -1;
-    InvDepthMoments band;
-    for (int k = 1; k <= K; ++k) {
-      band.add(bins_[i * K + static_cast<std::size_t>(k - 1)]);
-      if (band.n < cfg_.region_min_pixels) continue;
-      const InvDepthMoments rest = moments_minus(g.m, band);
-      if (rest.n < kSplitMinSide) break;
-      const PlaneFit fr = fit_plane(rest);
-      if (!fr.ok) continue;
-      for (int d = 0; d < nd; ++d) {
-        if (std::fabs(dirs_[d].dot(g.plane.normal)) > cos_pair) continue;
-        const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
-        if (!fb.ok || fb.rms_w > limit) continue;
-        const double ssr = fit_ssr(fb, band) + fit_ssr(fr, rest);
-        if (ssr < best) best = ssr, best_k = k, best_d = d;
-      }
+  const double ssr_joint = g.m.n * InvDepthMomentsMsr(g.m, g.plane.a, g.plane.b, g.plane.c);
+  double best = ssr_joint;
+  BandSplit out;
+  InvDepthMoments band;
+  for (int k = 1; k <= K; ++k) {
+    band.add(bins[k - 1]);
+    if (band.n < cfg_.region_min_pixels) continue;
+    // Below an edge the sliver lies behind the riser's plane (1/z below it): a convex edge.
+    if (below_edge && !(band.mean_residual(g.plane.a, g.plane.b, g.plane.c) < 0.0)) continue;
+    const InvDepthMoments rest = moments_minus(g.m, band);
+    if (rest.n < (below_edge ? static_cast<double>(cfg_.region_min_pixels) : kSplitMinSide)) break;
+    // What stays must be a plane (below an edge, one within the noise).
+    const PlaneFit fr = fit_plane(rest);
+    if (!fr.ok || (below_edge && fr.rms_w > limit)) continue;
+    for (int d = 0; d < nd; ++d) {
+      if (std::fabs(dirs_[d].dot(g.plane.normal)) > max_cos) continue;
+      // The sliver lies on that direction within the noise (a bent surface, a person, does not).
+      const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
+      if (!fb.ok || fb.rms_w > limit) continue;
+      // Below an edge, a convex edge as a tread's over its riser: each side lies beyond the
+      // other's plane (the band's side was checked above). At a concave one (a floor meeting a
+      // wall, a seat meeting its back) each lies in front of the other's: no tread there.
+      if (below_edge && !(rest.mean_residual(fb.a, fb.b, fb.c) < 0.0)) continue;
+      const double ssr = fit_ssr(fb, band) + fit_ssr(fr, rest);
+      if (ssr < best) best = ssr, out.rows = k, out.dir = d;
     }
-    if (best_d < 0 || ssr_joint - best < kSplitGain * sig2) continue;
-    std::vector<int>& pix = split_pixels_;
-    pix.clear();
-    for (int v = 0; v < best_k; ++v)
-      for (int u = 0; u < W_; ++u)
-        if (label_[v * W_ + u] == r) pix.push_back(v * W_ + u);
-    if (!move_to_new_region(grows, r, pix, best_d)) continue;
-    Grow& gr = grows[r];
-    int dir = gr.dir;
-    const PlaneFit f = region_plane(gr.m, dir);
-    if (f.ok) gr.plane = f, gr.dir = dir;
-    ++stats_.border_splits;
   }
+  if (out.dir >= 0 && ssr_joint - best < kSplitGain * sig2) out = BandSplit{};
+  return out;
+}
+
+void Segmentation::refit_region(Grow& g) const {
+  int dir = g.dir;
+  const PlaneFit f = region_plane(g.m, dir);
+  if (f.ok) g.plane = f, g.dir = dir;
 }
 
 void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
@@ -763,7 +786,6 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
   const float sin_cross = std::sin(15.f * 3.14159265f / 180.f);
   const float limit = 0.5f * tolerance_w();
   const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
-  const int nd = static_cast<int>(dirs_.size());
   // Candidate regions: planar, parallel to a dominant direction (a riser, the front of a nosing)
   // and square to another one (the treads).
   std::vector<int>& slot = cid_;
@@ -870,44 +892,16 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
   for (std::size_t i = 0; i < regs.size(); ++i) {
     const int r = regs[i];
     if (slot[r] < 0) continue;
-    const Grow& g = grows[r];
-    const double ssr_joint = g.m.n * InvDepthMomentsMsr(g.m, g.plane.a, g.plane.b, g.plane.c);
-    double best = ssr_joint;
-    int best_k = 0, best_d = -1;
-    InvDepthMoments band;
-    for (int k = 1; k <= K; ++k) {
-      band.add(bins_[i * K + static_cast<std::size_t>(k - 1)]);
-      if (band.n < cfg_.region_min_pixels || !(band.mean_residual(g.plane.a, g.plane.b, g.plane.c) < 0.0)) continue;
-      const InvDepthMoments rest = moments_minus(g.m, band);
-      if (rest.n < cfg_.region_min_pixels) break;
-      // What stays must still be one plane within the noise.
-      const PlaneFit fr = fit_plane(rest);
-      if (!fr.ok || fr.rms_w > limit) continue;
-      for (int d = 0; d < nd; ++d) {
-        if (std::fabs(dirs_[d].dot(g.plane.normal)) > sin_cross) continue;
-        // The sliver lies on that direction within the noise (a bent surface, a person, does not).
-        const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
-        if (!fb.ok || fb.rms_w > limit) continue;
-        // A convex edge, as a tread's over its riser: each side lies beyond the other's plane
-        // (1/z below it; the band's side was checked above). At a concave one (a floor meeting a
-        // wall, a seat meeting its back) each lies in front of the other's: no tread there.
-        if (!(rest.mean_residual(fb.a, fb.b, fb.c) < 0.0)) continue;
-        const double ssr = fit_ssr(fb, band) + fit_ssr(fr, rest);
-        if (ssr < best) best = ssr, best_k = k, best_d = d;
-      }
-    }
-    if (best_d < 0 || ssr_joint - best < kSplitGain * sig2) continue;
+    const BandSplit best = best_band_split(grows[r], &bins_[i * K], /*below_edge=*/true);
+    if (best.dir < 0) continue;
     std::vector<int>& pix = split_pixels_;
     pix.clear();
     for (int p : tops) {
       const int v = row_of(p);
-      for (int k = 0; k < best_k && v + k < H_ && label_[p + k * W_] == r; ++k) pix.push_back(p + k * W_);
+      for (int k = 0; k < best.rows && v + k < H_ && label_[p + k * W_] == r; ++k) pix.push_back(p + k * W_);
     }
-    if (!move_to_new_region(grows, r, pix, best_d)) continue;
-    Grow& gr = grows[r];
-    int dir = gr.dir;
-    const PlaneFit f = region_plane(gr.m, dir);
-    if (f.ok) gr.plane = f, gr.dir = dir;
+    if (!move_to_new_region(grows, r, pix, best.dir)) continue;
+    refit_region(grows[r]);
     ++stats_.edge_splits;
   }
 }

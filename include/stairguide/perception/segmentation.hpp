@@ -170,6 +170,14 @@ class Segmentation {
   /// The same below an occlusion edge (no readings above): a tread's visible sliver between its
   /// riser and the shadow of the next nosing, taken by the riser's region.
   void split_edge_bands(std::vector<Grow>& grows);
+  /// The band of a region's first rows (from the top border or below an occlusion edge) to split
+  /// off onto a dominant direction: rows 0 and dir -1 when none explains the region better.
+  struct BandSplit {
+    int rows = 0, dir = -1;
+  };
+  BandSplit best_band_split(const Grow& g, const InvDepthMoments* bins, bool below_edge) const;
+  /// Refits a region's plane after pixels left it (fixed to its dominant direction while they accept it).
+  void refit_region(Grow& g) const;
   /// Moves the pixels of region `r` listed in `pixels` to a new region on direction `dir`.
   /// Returns false (nothing changed) when the new region's fit fails.
   bool move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir);
