@@ -9,18 +9,47 @@ namespace stairguide {
 namespace {
 constexpr float kPi = 3.14159265358979f;
 constexpr float kHalfPi = 0.5f * kPi;
-// Wraps to (-pi/4, pi/4]: the representative of a direction modulo 90 degrees.
-float wrap_quarter(float a) {
-  while (a > 0.25f * kPi) a -= kHalfPi;
-  while (a <= -0.25f * kPi) a += kHalfPi;
-  return a;
-}
+float wrap_quarter(float a) { return manhattan_wrap(a); }
 }  // namespace
 
 Pose manhattan_pose_from_yaw(float yaw) {
   Pose T = Pose::Identity();
   T.linear() = Eigen::AngleAxisf(-yaw, Eigen::Vector3f::UnitY()).toRotationMatrix();
   return T;
+}
+
+float manhattan_wrap(float a) {
+  while (a > 0.25f * kPi) a -= kHalfPi;
+  while (a <= -0.25f * kPi) a += kHalfPi;
+  return a;
+}
+
+float manhattan_keep_branch(float yaw, const std::optional<float>& previous) {
+  if (!previous) return yaw;
+  float best = yaw, bestd = 1e9f;
+  for (int k = -1; k <= 1; ++k) {
+    const float c = yaw + k * kHalfPi;
+    const float dd = std::fabs(c - *previous);
+    if (dd < bestd) {
+      bestd = dd;
+      best = c;
+    }
+  }
+  const float hysteresis = 0.1745f;  // 10 degrees
+  return std::fabs(best) < 0.25f * kPi + hysteresis ? best : yaw;
+}
+
+void ManhattanHistogram::add(float a, float w) {
+  int bin = static_cast<int>((a + 0.25f * kPi) / kHalfPi * kBins);
+  bin = (bin % kBins + kBins) % kBins;
+  for (int k = -2; k <= 2; ++k) hist_[((bin + k) % kBins + kBins) % kBins] += w * (3 - std::abs(k));
+}
+
+float ManhattanHistogram::mode() const {
+  int peak = 0;
+  for (int b = 1; b < kBins; ++b)
+    if (hist_[b] > hist_[peak]) peak = b;
+  return -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
 }
 
 ManhattanTracker::ManhattanTracker(const ManhattanConfig& config, float max_range)
@@ -229,19 +258,10 @@ float ManhattanTracker::disagree_tolerance(const Vote& v) const {
 ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float total_area, bool bounding_only) {
   ManhattanEstimate est;
   // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
-  constexpr int kBins = 90;
-  float hist[kBins] = {};
-  for (const Vote& v : votes) {
-    if (bounding_only && v.inside) continue;
-    int bin = static_cast<int>((v.a + 0.25f * kPi) / kHalfPi * kBins);
-    bin = (bin % kBins + kBins) % kBins;
-    // Spread over neighbouring bins (1 degree each) so a peak is not split by a bin edge.
-    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += v.w * (3 - std::abs(k));
-  }
-  int peak = 0;
-  for (int b = 1; b < kBins; ++b)
-    if (hist[b] > hist[peak]) peak = b;
-  const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
+  ManhattanHistogram hist;
+  for (const Vote& v : votes)
+    if (!(bounding_only && v.inside)) hist.add(v.a, v.w);
+  const float mode = hist.mode();
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
   float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f, widest = 0.f;
   bool wide = false;
@@ -295,21 +315,7 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
               "riser in view, or too little of one to trust)";
     return est;
   }
-  float yaw = wrap_quarter(0.25f * std::atan2(ss, sc));
-  // Near +-45 degrees both branches are about as close to forward: keep the previous one.
-  if (prev_yaw_) {
-    float best = yaw, bestd = 1e9f;
-    for (int k = -1; k <= 1; ++k) {
-      const float c = yaw + k * kHalfPi;
-      const float dd = std::fabs(c - *prev_yaw_);
-      if (dd < bestd) {
-        bestd = dd;
-        best = c;
-      }
-    }
-    const float hysteresis = 0.1745f;  // 10 degrees
-    if (std::fabs(best) < 0.25f * kPi + hysteresis) yaw = best;
-  }
+  const float yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);
   est.found = true;
   est.yaw = yaw;
   est.T_manhattan_floor = manhattan_pose_from_yaw(yaw);

@@ -110,14 +110,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
 }
 
 namespace {
-constexpr float kPi = 3.14159265358979f;
-constexpr float kHalfPi = 0.5f * kPi;
-// Wraps to (-pi/4, pi/4]: the representative of a direction modulo 90 degrees.
-float wrap_quarter(float a) {
-  while (a > 0.25f * kPi) a -= kHalfPi;
-  while (a <= -0.25f * kPi) a += kHalfPi;
-  return a;
-}
+float wrap_quarter(float a) { return manhattan_wrap(a); }
 }  // namespace
 
 ManhattanSighting Perception::manhattan_sighting(const SceneResult& out, double timestamp) const {
@@ -203,16 +196,11 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
     hold_manhattan(own, odometry);
   }
   if (votes.empty()) return;
-  // The direction most of the weight agrees on (modulo 90 degrees): the mode of a histogram of 1
-  // degree bins, refined by the circular mean of 4 * angle of the votes near it (as the estimator).
-  constexpr int kBins = 90;
-  float hist[kBins] = {};
-  for (const HeldVote& v : votes) {
-    const int bin = ((static_cast<int>((v.a + 0.25f * kPi) / kHalfPi * kBins)) % kBins + kBins) % kBins;
-    for (int k = -2; k <= 2; ++k) hist[((bin + k) % kBins + kBins) % kBins] += v.w * static_cast<float>(3 - std::abs(k));
-  }
-  const int peak = static_cast<int>(std::max_element(hist, hist + kBins) - hist);
-  const float mode = -0.25f * kPi + (static_cast<float>(peak) + 0.5f) * kHalfPi / kBins;
+  // The direction most of the weight agrees on (modulo 90 degrees): the mode of a histogram,
+  // refined by the circular mean of 4 * angle of the votes near it (as the estimator).
+  ManhattanHistogram hist;
+  for (const HeldVote& v : votes) hist.add(v.a, v.w);
+  const float mode = hist.mode();
   float sc = 0.f, ss = 0.f;
   double newest = -1e300;
   for (const HeldVote& v : votes) {
@@ -238,19 +226,11 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
     std::snprintf(buf, sizeof buf,
                   "this view's planes made a frame %.1f deg off the one held in the world, and weigh less: kept "
                   "the held one",
-                  off * 180.f / kPi);
+                  off * 57.2957795f);
     out.manhattan_why = buf;
   }
-  // k_M is the dominant direction closest to forward (modulo 90 degrees), kept on the branch last
-  // reported near +-45 degrees, as ManhattanTracker does for the frames it sees.
-  if (last_yaw_) {
-    float best = yaw;
-    for (int k = -1; k <= 1; k += 2) {
-      const float c = yaw + static_cast<float>(k) * kHalfPi;
-      if (std::fabs(c - *last_yaw_) < std::fabs(best - *last_yaw_)) best = c;
-    }
-    if (std::fabs(best) < 0.25f * kPi + 0.1745f) yaw = best;  // 10 degrees of hysteresis
-  }
+  // k_M on the branch last reported, as ManhattanTracker keeps it for the frames it sees.
+  yaw = manhattan_keep_branch(yaw, last_yaw_);
   // Share of the planar area on vertical planes along the axes reported (the same measure the
   // estimator reports): stair modelling asks for its own share before it uses a frame.
   float total = 0.f, agree = 0.f;

@@ -38,6 +38,27 @@ struct ManhattanEstimate {
 /// Rotation about y_F by -yaw: maps floor coordinates into Manhattan coordinates.
 Pose manhattan_pose_from_yaw(float yaw);
 
+/// The representative of a direction modulo 90 degrees, in (-pi/4, pi/4].
+float manhattan_wrap(float a);
+
+/// k_M is the dominant direction closest to forward; near +-45 degrees both branches are about as
+/// close, so `yaw` is moved onto the branch of the `previous` k_M where that stays within 10
+/// degrees of 45 (hysteresis).
+float manhattan_keep_branch(float yaw, const std::optional<float>& previous);
+
+/// Weighted directions modulo 90 degrees in 1 degree bins, each spread over its neighbours so
+/// that a peak is not split by a bin edge.
+class ManhattanHistogram {
+ public:
+  void add(float a, float w);
+  /// rad, the centre of the fullest bin (the first of equals).
+  float mode() const;
+
+ private:
+  static constexpr int kBins = 90;
+  float hist_[kBins] = {};
+};
+
 class ManhattanTracker {
  public:
   /// `max_range`: the depth (m) beyond which the sensor gives no reading (CaptureConfig::max_range);
