@@ -220,6 +220,7 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
       out.manhattan_yaw = y;
       out.T_manhattan_floor = manhattan_pose_from_yaw(y);
       last_yaw_ = y;
+      classify_regions(out, classification_);  // left / right / front against the axes reported
       return;
     }
     char buf[160];
