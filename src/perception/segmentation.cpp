@@ -46,54 +46,58 @@ PlaneFit fit_plane_pca(const PointMoments& m) {
   return f;
 }
 
-PlaneFit fit_plane(const InvDepthMoments& m) {
-  PlaneFit f;
-  if (m.n < 3.0) return f;
-  const double in = 1.0 / m.n;
-  const double mu = m.su * in, mv = m.sv * in, mw = m.sw * in;
-  // Centred normal equations: better conditioned for small cells far from the image centre.
-  const double cuu = m.suu * in - mu * mu, cuv = m.suv * in - mu * mv, cvv = m.svv * in - mv * mv;
-  const double cuw = m.suw * in - mu * mw, cvw = m.svw * in - mv * mw, cww = m.sww * in - mw * mw;
-  const double det = cuu * cvv - cuv * cuv;
-  if (!(det > 1e-6 * (cuu * cvv + 1e-30)) || !(det > 1e-24)) return f;  // points on a line
-  const double a = (cuw * cvv - cvw * cuv) / det;
-  const double b = (cvw * cuu - cuw * cuv) / det;
-  const double c = mw - a * mu - b * mv;
-  const double g = std::sqrt(a * a + b * b + c * c);
-  if (!(g > 1e-9)) return f;
-  f.ok = true;
-  f.d = static_cast<float>(1.0 / g);
-  f.normal = Eigen::Vector3f(static_cast<float>(-a / g), static_cast<float>(-b / g), static_cast<float>(-c / g));
-  f.a = static_cast<float>(a);
-  f.b = static_cast<float>(b);
-  f.c = static_cast<float>(c);
-  f.rms_w = static_cast<float>(std::sqrt(std::max(0.0, cww - a * cuw - b * cvw)));
-  // The plane's point on the ray of the mean pixel stands in for the centroid.
-  const double wm = a * mu + b * mv + c;
-  if (wm > 1e-9) f.mean = Eigen::Vector3f(static_cast<float>(mu / wm), static_cast<float>(mv / wm), static_cast<float>(1.0 / wm));
-  return f;
-}
-
 namespace {
-/// fit_plane's ok, rms_w and mean.z() alone, by the same expressions (bit-identical), for the
-/// cell tests that keep nothing else of the fit: thousands of cells a frame, and the rest of a
-/// fit (normal, offset, centroid: six more divisions, a struct of 30 floats) was most of its cost.
-bool plane_rms_depth(const InvDepthMoments& m, float& rms_w, float& mean_z) {
+/// The plane 1/z = a u' + b v' + c of moments `m` by the centred normal equations (better
+/// conditioned for small cells far from the image centre), with what fit_plane and the cell tests
+/// take from it: g = |(a, b, c)|, the residual rms and 1/z at the mean pixel (wm). False for fewer
+/// than three points, points on a line, or a degenerate plane.
+struct CentredPlane {
+  double a, b, c, g, rms_w, wm, mu, mv;
+};
+bool solve_centred_plane(const InvDepthMoments& m, CentredPlane& p) {
   if (m.n < 3.0) return false;
   const double in = 1.0 / m.n;
   const double mu = m.su * in, mv = m.sv * in, mw = m.sw * in;
   const double cuu = m.suu * in - mu * mu, cuv = m.suv * in - mu * mv, cvv = m.svv * in - mv * mv;
   const double cuw = m.suw * in - mu * mw, cvw = m.svw * in - mv * mw, cww = m.sww * in - mw * mw;
   const double det = cuu * cvv - cuv * cuv;
-  if (!(det > 1e-6 * (cuu * cvv + 1e-30)) || !(det > 1e-24)) return false;
+  if (!(det > 1e-6 * (cuu * cvv + 1e-30)) || !(det > 1e-24)) return false;  // points on a line
   const double a = (cuw * cvv - cvw * cuv) / det;
   const double b = (cvw * cuu - cuw * cuv) / det;
   const double c = mw - a * mu - b * mv;
   const double g = std::sqrt(a * a + b * b + c * c);
   if (!(g > 1e-9)) return false;
-  rms_w = static_cast<float>(std::sqrt(std::max(0.0, cww - a * cuw - b * cvw)));
-  const double wm = a * mu + b * mv + c;
-  mean_z = wm > 1e-9 ? static_cast<float>(1.0 / wm) : 0.f;
+  p = {a, b, c, g, std::sqrt(std::max(0.0, cww - a * cuw - b * cvw)), a * mu + b * mv + c, mu, mv};
+  return true;
+}
+}  // namespace
+
+PlaneFit fit_plane(const InvDepthMoments& m) {
+  PlaneFit f;
+  CentredPlane p;
+  if (!solve_centred_plane(m, p)) return f;
+  f.ok = true;
+  f.d = static_cast<float>(1.0 / p.g);
+  f.normal = Eigen::Vector3f(static_cast<float>(-p.a / p.g), static_cast<float>(-p.b / p.g), static_cast<float>(-p.c / p.g));
+  f.a = static_cast<float>(p.a);
+  f.b = static_cast<float>(p.b);
+  f.c = static_cast<float>(p.c);
+  f.rms_w = static_cast<float>(p.rms_w);
+  // The plane's point on the ray of the mean pixel stands in for the centroid.
+  if (p.wm > 1e-9)
+    f.mean = Eigen::Vector3f(static_cast<float>(p.mu / p.wm), static_cast<float>(p.mv / p.wm), static_cast<float>(1.0 / p.wm));
+  return f;
+}
+
+namespace {
+/// fit_plane's ok, rms_w and mean.z() alone (the same solve), for the cell tests that keep nothing
+/// else of the fit: thousands of cells a frame, and the rest of a fit (normal, offset, centroid:
+/// six more divisions, a struct of 30 floats) was most of its cost.
+bool plane_rms_depth(const InvDepthMoments& m, float& rms_w, float& mean_z) {
+  CentredPlane p;
+  if (!solve_centred_plane(m, p)) return false;
+  rms_w = static_cast<float>(p.rms_w);
+  mean_z = p.wm > 1e-9 ? static_cast<float>(1.0 / p.wm) : 0.f;
   return true;
 }
 
