@@ -132,6 +132,7 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   out.ms = ms_since(t0);
   return out;
 }
+
 // The odometry's pose is asked for only now: running beside perception on the same frame, it has
 // usually finished the frame by the time segmentation has. Perception waits for it only on a view
 // that needs a frame carried; a view seen before its pose came is held when the pose comes.
