@@ -149,17 +149,18 @@ void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, 
     }
   };
   flush();
-  const ManhattanSighting own = m.perception.manhattan_sighting(m.scene, frame.timestamp);
-  const bool carry = !own.valid && m.scene.floor_found &&
+  // process() just ran: a frame found is this view's own (apply_odometry has not carried one in).
+  const bool seen = m.scene.manhattan_found;
+  const bool carry = !seen && m.scene.floor_found &&
                      (m.perception.can_carry_manhattan(frame.timestamp) || !m.pending.empty());
   OdometryLink link;
   const PoseAnswer a = odometry(seq, link, carry);
   if (a == PoseAnswer::kReady) {
     flush();  // the odometry has passed the views before this one
     m.perception.apply_odometry(link, frame.timestamp, m.scene);
-  } else if (a == PoseAnswer::kNotYet && own.valid) {
+  } else if (a == PoseAnswer::kNotYet && seen) {
     if (m.pending.size() == kMaxPending) m.pending.pop_front();
-    m.pending.emplace_back(seq, own);
+    m.pending.emplace_back(seq, m.perception.manhattan_sighting(m.scene, frame.timestamp));
   }
 }
 
