@@ -228,27 +228,28 @@ TEST(StairsSynthetic, Suite) {
     }
     const double stage_recall = static_cast<double>(a.tp) / std::max(1, a.tp + a.fn - perception_fn);
     std::printf("recall where perception gave a floor and step candidates: %.4f\n", stage_recall);
-    // Measured on the whole walks (stride 3, seed 5, floorless route on): recall 0.979 (323 of
+    // Measured on the whole walks (stride 3, seed 5, floorless route on): recall 0.991 (327 of
     // 330), fully visible 1.000 (125 of 125; issue 4 asks >= 0.99), within 1 m of the first edge
-    // 175 of 181 (descending 87 of 89). Descending: 118 of 120 (the 2 left are the step over the
-    // edge, where perception has no floor), none missed by the stairs stage. Before this round
-    // fully visible was 0.976: two cold views whose floor strip, deeper than the flight's tread,
-    // is the floor (floorless.hpp), one far flight whose second tread took in a tilted crease
-    // strip (segmentation now splits those), and after that fix a floor strip 5 cm deep at the
-    // foot of the steps that tied the direction vote. The bounds are the measured figures less a
-    // margin, so a regression fails; the fully visible one is the issue's.
-    EXPECT_GE(a.recall(), 0.96);
+    // 179 of 181 (descending 89 of 89). Descending: 120 of 120. Before the "lean" at the first
+    // edge (floorless.hpp) the step over the edge was missed in every approach walk: 0.979, 118 of
+    // 120 descending here, 48 frames on seeds 1-4 of the walks. Before that round fully visible
+    // was 0.976: two cold views whose floor strip, deeper than the flight's tread, is the floor
+    // (floorless.hpp), one far flight whose second tread took in a tilted crease strip
+    // (segmentation now splits those), and after that fix a floor strip 5 cm deep at the foot of
+    // the steps that tied the direction vote. The bounds are the measured figures less a margin,
+    // so a regression fails; the fully visible one is the issue's.
+    EXPECT_GE(a.recall(), 0.98);
     EXPECT_GE(a.recall_fully_visible(), 0.99);
     EXPECT_GE(stage_recall, 0.98);
     {
       const EvalSummary& d = s.table.by_kind.at("descending");
-      EXPECT_GE(d.recall(), 0.96);
+      EXPECT_GE(d.recall(), 0.99);
       EXPECT_EQ(d.full_fn, 0) << "a fully visible descending flight missed";
       EXPECT_EQ(s.descending_stage_misses, 0) << "a descending flight refused by the stairs stage";
       const auto& kb = s.kind_bins.at("descending");
-      EXPECT_GE(kb[0], 82) << "descending frames detected within 1 m of the edge (measured 87 of 89)";
+      EXPECT_GE(kb[0], 87) << "descending frames detected within 1 m of the edge (measured 89 of 89)";
     }
-    EXPECT_GE(s.bin_tp[0], 168) << "frames detected within 1 m of the first edge (measured 175 of 181)";
+    EXPECT_GE(s.bin_tp[0], 175) << "frames detected within 1 m of the first edge (measured 179 of 181)";
     const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3], far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
     std::printf("recall from 1 m out: %.4f (%d frames)\n", static_cast<double>(far_tp) / std::max(1, far_tp + far_fn),
                 far_tp + far_fn);

@@ -16,6 +16,13 @@ constexpr float kMinRise = 0.05f;       // m, a higher level's near boundary thi
                                         // than the lower one's says ascending (descending)
 constexpr float kFloorDepthSlack = 0.08f;  // m, a level cut by the image border and seen deeper than
                                            // the tread by this is no tread (nosing, edge noise)
+// With the chest moved towards the next level beyond the anchor tolerance (run_anchored), the user
+// stands at the first edge: it lies at most kLeanReach ahead of the camera's vertical (the lean
+// starts within the last stride before the edge: half a tread in the walks, plus the edge's noise)
+// and at most kLeanBehind behind it (a chest camera hangs 10-15 cm ahead of the feet, more when
+// leaning; the feet are still before the edge).
+constexpr float kLeanReach = 0.35f;   // m
+constexpr float kLeanBehind = 0.20f;  // m
 
 float clampf(float x, float lo, float hi) { return std::min(hi, std::max(lo, x)); }
 
@@ -507,9 +514,31 @@ void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrins
   const float a0 = static_cast<float>(dir) * (h0 + camera_height);
   trace_.first_offset = a0;
   const int kmax = 1 + std::max(0, det_.floorless_max_hidden_steps);
-  const int k = riser > 0.f ? static_cast<int>(std::lround(a0 / riser)) : -1;
+  const float tol = det_.floorless_anchor_tolerance;
+  int k = riser > 0.f ? static_cast<int>(std::lround(a0 / riser)) : -1;
   out.levels = n;
-  if (k < 0 || k > kmax || std::fabs(a0 - static_cast<float>(k) * riser) > det_.floorless_anchor_tolerance) {
+  bool lean = false;
+  if (riser > 0.f && std::fabs(a0 - static_cast<float>(k) * riser) > tol) {
+    // The remembered height is the camera's over the feet of a user standing upright. Stepping
+    // onto the next level, the chest starts moving towards it (up a climb, down a descent) before
+    // the foot leaves the floor: by the time the foot reaches the edge it has gone up to half a
+    // riser. The first level seen then lies k risers from the feet less that lean: k is the
+    // next whole number of risers beyond the tolerance, the lean at most half a riser (plus
+    // half the tolerance). A user whose chest has moved that far must stand at the first edge,
+    // which the model checks below.
+    k = static_cast<int>(std::floor((a0 + tol) / riser)) + 1;
+    const float d = static_cast<float>(k) * riser - a0;
+    lean = d > tol && d <= 0.5f * (riser + tol);
+    if (lean) trace_.lean = d;
+    else k = -1;
+  }
+  // A chest camera hangs ahead of the feet: with the user at the first edge it is over the first
+  // tread, and one more step lies under the view; going down, the levels lie deeper and the view's
+  // lowest rays reach them farther ahead, one more again (a high camera sees the first level 3
+  // risers up at the foot of a climb, 4 down at the top of a descent). Those are allowed only
+  // where the model puts the first edge at the camera's vertical, as for a lean.
+  const bool extra_hidden = k > kmax;
+  if (k < 0 || k > kmax + 1 + (dir < 0 ? 1 : 0)) {
     // Not a whole number of risers from the feet (or too many steps hidden): a stack of shelves,
     // furniture, or a staircase the remembered height no longer fits. Nothing is reported.
     out.detected = false;
@@ -535,6 +564,20 @@ void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrins
     }
   }
   out.without_floor = false;
+  if ((lean || extra_hidden) && out.detected) {
+    // The chest leans towards the next level only in the last stride before its edge: the first
+    // edge must lie that near ahead of the camera's vertical (not behind it: the feet would be on
+    // the step). Farther, the stack is not k risers from these feet (shelves, furniture, or a
+    // remembered height that no longer fits) and nothing is reported rather than a step off.
+    const Eigen::Vector3f zs = out.T_camera_stair.linear().col(2);
+    const float ahead = zs.dot(out.T_camera_stair.translation());
+    trace_.lean_edge_ahead = ahead;
+    if (ahead < -kLeanBehind || ahead > kLeanReach) {
+      out.detected = false;
+      out.verdict = StairVerdict::kNoFirstStep;
+      trace_.first_index = -1;
+    }
+  }
 }
 
 void FloorlessStairs::add_hidden_steps(StairResult& out, int dir, int hidden) {

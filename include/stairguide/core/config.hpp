@@ -283,7 +283,7 @@ struct StairDetectionConfig {
   int floorless_min_level_pixels = 500;     ///< px, smallest level (all its regions) of a floorless stack
   int floorless_min_levels = 2;             ///< levels one riser apart needed without a floor
   float floorless_anchor_tolerance = 0.04f; ///< m, with the camera height remembered: the first level seen lies a whole number of risers from the feet within this
-  int floorless_max_hidden_steps = 1;       ///< with the camera height remembered: steps between the feet and the first level seen that may be out of view
+  int floorless_max_hidden_steps = 1;       ///< with the camera height remembered: steps between the feet and the first level seen that may be out of view (floorless.hpp: one more, two going down, with the first edge at the camera's vertical)
 
   template <class V> void visit(V& v) {
     v.num(same_level_tolerance, "same_level_tolerance_cm", Unit::kCentimetre, 0.5, 20,

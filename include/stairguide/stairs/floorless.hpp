@@ -44,6 +44,21 @@
 /// result is a normal detection (`without_floor` false, `floor_remembered` set): heights from the
 /// floor, the origin on the first step's edge, the distance known.
 ///
+/// *At the first edge* (the "lean"): the remembered height is the camera's over the feet of a user
+/// walking on the level. Stepping onto the next level, the chest moves towards it (up a climb,
+/// down a descent) before the foot leaves the floor, by up to half a riser when the foot reaches
+/// the edge; and a chest camera hangs ahead of the feet, over the first tread, so one more step is
+/// out of view (two going down, where the deeper levels are reached farther ahead by the view's
+/// lowest rays). A first level k risers from the feet less a lean beyond the tolerance (at most
+/// half a riser plus half the tolerance), or those steps more than `floorless_max_hidden_steps`
+/// out of view, is taken only when the model puts the first edge at the camera's vertical (at
+/// most 0.35 m ahead, 0.2 m behind): the user stands at the edge. Elsewhere such a stack is
+/// refused as before (a lean the other way, the chest lowered at the foot of a climb by half a
+/// riser or more, would be read as a lean onto the next step: one step off). In
+/// the approach walks this keeps the staircase through the last 5-8 frames before the first step
+/// (the top of a descent, where perception no longer verifies the floor either, and the foot of a
+/// climb), first edge within a few mm.
+///
 /// *Cold start* (nothing remembered). A level outside the stack that can be the user's floor (a
 /// chest camera's height below the camera, FloorConfig height range, and 1..1 +
 /// `floorless_max_hidden_steps` risers from the first seen level on the user's side; the floor
@@ -88,6 +103,10 @@ struct FloorlessTrace {
   bool floor_seen = false;             ///< cold start: the user's floor seen outside the stack gave the camera height
   int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
   float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
+  /// m, anchored: how far the chest had moved towards the flight (first_index risers less
+  /// first_offset) when that is more than the anchor tolerance (the user stepping onto it); 0 otherwise.
+  float lean = 0.f;
+  float lean_edge_ahead = 0.f;         ///< m, with a lean or the extra hidden steps: the first edge's distance ahead of the camera's vertical
   bool first_near_cut = false;         ///< the first seen level's near boundary lies on the image border
   float first_depth = 0.f;             ///< m, cold start: depth seen of that level (a floor strip deeper than a tread is the floor)
   int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
