@@ -19,6 +19,9 @@ constexpr float kViewBottomSlack = 0.02f;
 // A first step found by its stack (build_stack) lies within this of the floor seen from above: a
 // person or a wall end (about half a metre) hides the foot of the flight, plus the usual radius.
 constexpr float kStackReach = 1.0f;
+// A lone first level is set aside for another first step at most this many times (a head, then
+// the shoulders).
+constexpr int kMaxLoneLevels = 3;
 }  // namespace
 
 StairDetection::StairDetection(const ClassificationConfig& classification, const StairDetectionConfig& config)
@@ -116,7 +119,51 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
   hyp.candidates = static_cast<int>(order_.size());
   assigned_.assign(order_.size(), 0);
   sweep(hyp);
-  if (hyp.step_levels() == 0 && direction < 0 && floor_tracked_ && !floor.regions.empty()) build_hidden(hyp);
+  if (hyp.step_levels() == 1) {
+    // A lone level, nothing one riser beyond it: the first candidate at a first step's height
+    // that touches the floor may be a person's head or shoulders standing in a stairwell, or a
+    // sliver at its rim, and it keeps the real first step (a few cm lower or higher) out. Try the
+    // other candidates as the first step, the lone level left out, and keep a flight (two levels
+    // or more) if they give one. A lone level that is the only thing there stays as it was.
+    const std::vector<LevelSeed> saved_levels = hyp.levels;
+    const std::vector<char> saved_assigned = assigned_;
+    bool found = false;
+    for (int tries = 0; tries < kMaxLoneLevels && !found; ++tries) {
+      const std::vector<char> left_out = assigned_;  // the lone levels so far stay out of the sweep
+      hyp.levels.resize(1);
+      sweep(hyp);
+      if (hyp.step_levels() >= 2) {
+        for (std::size_t i = 0; i < assigned_.size(); ++i)
+          if (left_out[i]) assigned_[i] = 0;
+        found = true;
+      } else if (hyp.step_levels() == 0) {
+        break;
+      }
+    }
+    if (!found) {
+      hyp.levels = saved_levels;
+      assigned_ = saved_assigned;
+    }
+  }
+  if (direction < 0 && floor_tracked_ && !floor.regions.empty()) {
+    if (hyp.step_levels() == 0) {
+      build_hidden(hyp);
+    } else if (hyp.step_levels() == 1) {
+      // One level alone one riser down, and nothing one riser below it: a sliver at the stairwell's
+      // rim (a rail, a wall top mixed with the floor) can take the first step's place and hide a
+      // flight whose first treads are under the view. Try the hidden-first-steps route on the
+      // other candidates; its stack (evenly spaced, a whole number of risers below the tracked
+      // floor, reaching the bottom of the view) replaces the lone level.
+      const std::vector<LevelSeed> saved_levels = hyp.levels;
+      const std::vector<char> saved_assigned = assigned_;
+      hyp.levels.resize(1);
+      std::fill(assigned_.begin(), assigned_.end(), 0);
+      if (!build_hidden(hyp)) {
+        hyp.levels = saved_levels;
+        assigned_ = saved_assigned;
+      }
+    }
+  }
   if (hyp.step_levels() == 0 && direction > 0 && !floor.regions.empty()) build_stack(hyp);
 
   hyp.rejected = 0;

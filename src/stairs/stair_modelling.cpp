@@ -15,15 +15,16 @@ constexpr float kHalfPi = 0.5f * kPi;
 // itself. Inner quantiles keep depth noise and stray pixels out, and the extrapolation removes the
 // inward bias a plain low quantile would have.
 constexpr float kQ1 = 0.03f, kQ2 = 0.12f;
-constexpr std::size_t kMinRobust = 24;
-constexpr float kLandingDepth = 0.6f;
+constexpr std::size_t kMinRobust = 24;    // fewer points: plain extremes
+constexpr float kLandingDepth = 0.6f;     // m, a level deeper than this is a landing or a floor
 constexpr float kShallowFloor = 0.5f;     // m, less floor than this in front of the steps is suspect
 constexpr int kDoubtfulPixels = 200;      // px, a level this big one riser below the floor
-constexpr float kOtherFloorWidth = 1.5f;  // m, a level this wide running out of view is no furniture     // m, a level deeper than this is a landing or a floor
+constexpr float kOtherFloorWidth = 1.5f;  // m, a level this wide running out of view is no furniture
+constexpr float kBigLevel = 4.f;          // a level this many times the median level's area is no step (axes)
 constexpr float kBoundaryBin = 0.05f;     // m, lateral bins of the boundary line of a single level
-constexpr float kBoundaryInlier = 0.015f; // m, a bin on the boundary line    // fewer points: plain extremes
-constexpr std::size_t kHullPoints = 600;  // subsample for the convex hulls (orientation only)
-constexpr std::size_t kStepPoints = 4000; // points per level used for edges and extents
+constexpr float kBoundaryInlier = 0.015f;  // m, a bin on the boundary line
+constexpr std::size_t kHullPoints = 600;   // subsample for the convex hulls (orientation only)
+constexpr std::size_t kStepPoints = 4000;  // points per level used for edges and extents
 constexpr std::size_t kFloorPoints = 3000;
 constexpr std::size_t kOutputPoints = 4000;  // per level in StairResult::level_data
 
@@ -262,6 +263,24 @@ float StairModelling::boundary_median(const std::vector<Eigen::Vector2f>& pts, c
   return boundary_median_ab(ba_, bb_, true, f);
 }
 
+bool StairModelling::far_side_cut(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2,
+                                  const Eigen::Vector2f& z2, const BoundaryFrame& f) {
+  if (!K_ || pts.size() < 10) return false;  // (boundary_median_ab leaves its bins as they were)
+  ba_.clear();
+  bb_.clear();
+  for (const auto& p : pts) {
+    ba_.push_back(x2.dot(p));
+    bb_.push_back(z2.dot(p));
+  }
+  // boundary_median_ab keeps only the bins whose farthest point lies inside the image: when most
+  // bins lose theirs to the border, the far side is the view's end.
+  boundary_median_ab(ba_, bb_, false, f);
+  std::size_t bins = 0;
+  for (int c : bin_count_)
+    if (c >= 3) ++bins;
+  return bins >= 3 && 2 * bin_e_.size() < bins;
+}
+
 bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& xs, const Eigen::Vector3f& up,
                               const Eigen::Vector3f& zs, float a_mid, float edge_b, const StairLevel& o,
                               float plane) const {
@@ -336,7 +355,9 @@ void StairModelling::refine_single_axis(const Level2d& L, Eigen::Vector2f& z2, c
 
 float StairModelling::area_cost(float angle, int first, int last) const {
   float s = 0.f;
-  for (int k = first; k <= last; ++k) s += rect_area(levels_[static_cast<std::size_t>(k)].hull, angle);
+  for (int k = first; k <= last; ++k)
+    if (!axis_skip_[static_cast<std::size_t>(k)])
+      s += rect_area(levels_[static_cast<std::size_t>(k)].hull, angle);
   return s;
 }
 
@@ -414,6 +435,26 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   }
 
   // ---- horizontal axes: minimum summed bounding-rectangle area, seeded by the best step ----
+  // A level many times a tread's area (the lower floor, a landing) is no step: where the border of
+  // the image cuts it obliquely its rectangle turns with the cut and, by its sheer area, outweighs
+  // the treads' (12 degrees off on a far descending flight; an ascending one's landing cut by the
+  // image top made its treads look too short). The axes come from the others when two or more
+  // remain.
+  axis_skip_.assign(static_cast<std::size_t>(n + 1), 0);
+  if (n >= 3) {
+    sorted_.clear();
+    for (int k = 1; k <= n; ++k) sorted_.push_back(polygon_area(levels_[static_cast<std::size_t>(k)].hull));
+    tmp_.assign(sorted_.begin(), sorted_.end());
+    std::nth_element(tmp_.begin(), tmp_.begin() + static_cast<long>(tmp_.size() / 2), tmp_.end());
+    const float median = tmp_[tmp_.size() / 2];
+    int kept = 0;
+    for (int k = 1; k <= n; ++k) {
+      const bool big = sorted_[static_cast<std::size_t>(k - 1)] > kBigLevel * median;
+      axis_skip_[static_cast<std::size_t>(k)] = big ? 1 : 0;
+      kept += axis_skip_[static_cast<std::size_t>(k)] ? 0 : 1;
+    }
+    if (kept < 2) std::fill(axis_skip_.begin(), axis_skip_.end(), 0);
+  }
   const float seed_angle = levels_[static_cast<std::size_t>(seed)].pca_angle;
   float best = seed_angle, best_cost = std::numeric_limits<float>::max();
   for (int d = -45; d < 45; ++d) {
@@ -535,6 +576,13 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     // A level far deeper than a tread is a landing, the upper floor or the lower floor: its far
     // side is no step edge and its sides need not follow the staircase's.
     if (n >= 2 && o.depth_max - o.depth_min > kLandingDepth) landing_[static_cast<std::size_t>(k)] = 1;
+    // Descending, the lowest level seen (often the lower floor) may run out of the view at its far
+    // side: its far boundary is then where the image ends, not a step edge, and it says nothing of
+    // its width either, just as a landing. (Seen far away, the image top cuts the lower floor to
+    // less than a landing's depth, and its "edge" a tread or more beyond the staircase's line
+    // made the edges look unevenly spaced.)
+    if (dir < 0 && n >= 2 && k == n && far_side_cut(L.pts, x2, z2, BoundaryFrame{xs, zs, up, L.plane}))
+      landing_[static_cast<std::size_t>(k)] = 1;
     if (!landing_[static_cast<std::size_t>(k)]) ++steps_not_landing;
   }
   float a_min = std::numeric_limits<float>::max(), a_max = -a_min;
@@ -892,6 +940,31 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
       out.kind = n >= 2 ? StairKind::kAscending : StairKind::kSingleStep;
       out.verdict = StairVerdict::kFloorDoubtful;
       return;
+    }
+  }
+  // Descending, the mirror case: perception refused the user's own floor (the first tread below
+  // it lies nearer the user) and took that tread for the floor. The flight then comes out one step
+  // short, its first edge a tread too far: a step the user does not expect. The "floor" is a strip
+  // seen less deep than a landing before the drop, and the real floor lies one riser above it,
+  // larger than it and reaching the bottom of the view beside it. A tracked floor was verified on
+  // the frames before and is not doubted.
+  if (dir < 0 && floor_edge && K_ && !scene.floor_tracked && fl.edge - fl.depth_min < kShallowFloor) {
+    int floor_px = 0;
+    for (int r : hyp.levels[0].regions) floor_px += scene.regions[static_cast<std::size_t>(r)].pixel_count;
+    const float cos_par = std::cos(cls_.parallel_threshold);
+    const int bottom = K_->height - static_cast<int>(0.02f * static_cast<float>(K_->height));
+    for (const PlaneRegion& r : scene.regions) {
+      if (r.cls != RegionClass::kStepCandidate && r.cls != RegionClass::kObstacle) continue;
+      if (std::fabs(r.normal.dot(up)) < cos_par || r.pixel_count < std::max(kDoubtfulPixels, floor_px))
+        continue;
+      if (std::fabs(up.dot(r.centroid) - levels_[0].plane - riser) >= det_.same_level_tolerance) continue;
+      int lowest = -1;
+      for (int px : r.pixels) lowest = std::max(lowest, px / K_->width);
+      if (lowest >= bottom) {
+        out.kind = StairKind::kDescending;
+        out.verdict = StairVerdict::kFloorDoubtful;
+        return;
+      }
     }
   }
 

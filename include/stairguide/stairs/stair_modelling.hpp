@@ -7,14 +7,18 @@
 ///   their points together; the floor transform's up when it disagrees.
 /// - Horizontal axes: the rotation about y_S that minimises the summed bounding-rectangle areas of
 ///   the steps, searched from the principal axis of the step with the greatest extent (hull area over
-///   rectangle area). When the scene has enough Manhattan evidence and the Manhattan axes agree
-///   with the steps' own within `manhattan_max_disagreement`, the Manhattan axes are used (method
-///   kManhattan); otherwise the steps' (kPca). z_S points from the user into the staircase.
+///   rectangle area), levels over four times the median level's area (a landing, the lower floor,
+///   whose rectangle turns with the image border cutting them) left out. When the scene has enough
+///   Manhattan evidence and the Manhattan axes agree with the steps' own within
+///   `manhattan_max_disagreement`, the Manhattan axes are used (method kManhattan); otherwise the
+///   steps' (kPca). z_S points from the user into the staircase.
 /// - Each step's points are moved along their camera ray onto the level's plane (depth noise lies
 ///   along the ray, so this removes most of it), then each level's step edge is found in z_S:
 ///   ascending, the near edge of each tread (its nosing); descending, the far edge of each level
-///   (the floor's far edge is the first). Edges are extrapolated from two low quantiles, which is
-///   unbiased for evenly spread points and insensitive to a few strays. Ascending, the risers
+///   (the floor's far edge is the first; the lowest level's far side on the image border is the
+///   view's end, no edge, and that level is taken as the lower floor). Edges are extrapolated from
+///   two low quantiles, which is unbiased for evenly spread points and insensitive to a few
+///   strays. Ascending, the risers
 ///   facing the user place the edges in grazing views, and replace an edge whose tread's near rows
 ///   are hidden (one lying more than a nosing beyond its riser).
 /// - Tread: slope of the edge positions against the step index (edge to edge); riser: slope of the
@@ -26,6 +30,9 @@
 ///   border only against half the minimum), evenly spaced edges; a
 ///   single level by size (obstacle / single step / curb, paper 4.1 last paragraph); a level one
 ///   riser below the floor starting at the shadow of the floor's edge is a drop however shallow.
+///   An untracked floor seen less deep than a landing is refused (kFloorDoubtful): ascending, with a
+///   level one riser below it in view or not reaching the image bottom; descending, with a larger
+///   level one riser above it reaching the image bottom (the first tread taken for the floor).
 
 #include <Eigen/Core>
 #include <vector>
@@ -74,11 +81,15 @@ class StairModelling {
   float boundary_median_ab(const std::vector<float>& a, const std::vector<float>& b, bool low, const BoundaryFrame& f);
   float boundary_median(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
                         const BoundaryFrame& f);
-  /// Turns z2 so that the near boundary of a single level runs along x.
+  /// True when the far side of a level (points in the basis x2, z2) lies mostly on the image
+  /// border: its far boundary is where the view ends. False without the intrinsics.
+  bool far_side_cut(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2,
+                    const Eigen::Vector2f& z2, const BoundaryFrame& f);
   /// True when a vertical panel reaching above the single level `o` stands at one of its lateral
   /// ends over its depth (a shelf's or cabinet's bottom board). Axes and positions as in validation.
   bool boxed_in(const SceneResult& scene, const Eigen::Vector3f& xs, const Eigen::Vector3f& up,
                 const Eigen::Vector3f& zs, float a_mid, float edge_b, const StairLevel& o, float plane) const;
+  /// Turns z2 so that the near boundary of a single level runs along x.
   void refine_single_axis(const Level2d& level, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
                           const Eigen::Vector3f& e2, const Eigen::Vector3f& up);
   float robust_low(std::vector<float>& v) const;
@@ -95,6 +106,7 @@ class StairModelling {
   std::vector<float> ba_, bb_, a_band_, bin_a_, bin_e_, bin_ext_, bin_at_, sorted_, tmp_;  ///< scratch for boundaries
   std::vector<int> bin_count_;
   std::vector<char> landing_;         ///< per level: deeper than a tread (landing or floor)
+  std::vector<char> axis_skip_;       ///< per level: left out of the axes' area cost (a landing)
   std::vector<char> outlier_;         ///< per level: edge off the staircase's line
   std::vector<float> riser_at_;       ///< per level: position along z_S of the riser below it (NaN: none)
   std::vector<int> riser_n_;          ///< per level: points of that riser's region
