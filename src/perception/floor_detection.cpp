@@ -204,6 +204,43 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
   return false;
 }
 
+bool FloorDetector::middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near) {
+  // A plane with a bigger level one riser above it (anywhere in view) and another one riser below
+  // it, starting beyond its near edge within its width: the first tread of a descent, the floor
+  // around the stairwell above it and the next tread below it (seen cold at the top of a flight,
+  // the floor under the user's feet out of view). The floor the user stands on is not a level
+  // between a bigger one a riser above and a drop ahead. Without this, the first tread, reaching
+  // nearer the user's feet than the floor beside the stairwell, was taken for the floor.
+  const PlaneRegion& C = regions[c];
+  if (C.points.empty()) return false;
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
+  auto rise_ok = [&](float rise) { return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max; };
+  bool above = false;
+  for (const PlaneRegion& U : regions)
+    // Normals face the camera: a plane above C is nearer the camera, its offset smaller.
+    if (!U.points.empty() && U.normal.dot(C.normal) >= cos_par && U.area >= C.area && rise_ok(C.offset - U.offset))
+      above = true;
+  if (!above) return false;
+  Eigen::Vector3f fwd = Eigen::Vector3f::UnitZ() - C.normal * C.normal.z();  // the camera's forward, levelled
+  if (fwd.norm() < 1e-3f) return false;
+  const Eigen::Vector3f side = C.normal.cross(fwd.normalized());
+  lateral_.clear();
+  for (const auto& q : C.points) lateral_.push_back(side.dot(q));
+  const float lo = percentile(lateral_, 20), hi = percentile(lateral_, 980);
+  for (const PlaneRegion& D : regions) {
+    if (D.points.empty() || D.normal.dot(C.normal) < cos_par || !rise_ok(D.offset - C.offset)) continue;
+    const float t = side.dot(D.centroid);
+    if (t < lo || t > hi) continue;
+    float d_near = 1e9f;
+    for (const auto& q : D.points) d_near = std::min(d_near, foot_distance(C.normal, q));
+    if (d_near > near.distance && d_near - near.distance <= cfg_.ambiguous_depth_max) {
+      stack_below_ = true;
+      return true;
+    }
+  }
+  return false;
+}
+
 FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame) {
   FloorEstimate est;
   const int n = static_cast<int>(regions.size());
@@ -269,7 +306,9 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     const Reach near = reach(f);
     const bool clear = nothing_below(f, near) && !drop_under_edge(f, frame);
     // The tracked floor has been told from the steps already: no ambiguity left.
-    const bool stair = clear && !tracked && stair_from_view_edge(regions, chosen, near, frame.depth.cols);
+    stack_below_ = false;
+    const bool stair = clear && !tracked &&
+                       (stair_from_view_edge(regions, chosen, near, frame.depth.cols) || middle_of_stack(regions, chosen, near));
     if (clear && !stair) {
       est.tracked = tracked;
       anchor_ = f.offset;
@@ -289,8 +328,12 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     else ++rejected_stair;
     const Eigen::Vector3f n0 = f.normal;
     const float d0 = f.offset;
+    // A tread of a descent (a level a riser below it ahead, the floor a riser above): every plane
+    // lower than it is a lower tread or the floor at the foot of the flight.
+    const bool drop_lower = stair && stack_below_;
     cand.erase(std::remove_if(cand.begin(), cand.end(),
                               [&](int i) {
+                                if (drop_lower && regions[i].offset > d0) return true;
                                 return regions[i].normal.dot(n0) >= std::cos(cfg_.horizontal_tolerance) &&
                                        std::fabs(regions[i].offset - d0) < cfg_.inlier_distance;
                               }),
@@ -303,7 +346,8 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     else if (rejected_stair == 0)
       est.why = "every floor-like plane has something below it nearer the user (a step, a seat)";
     else if (rejected_below == 0)
-      est.why = "the floor-like plane may be a tread: a step rises right after where the view starts";
+      est.why = "the floor-like plane may be a tread: a step rises right after where the view starts, or it lies a "
+                "riser below a bigger level with a drop ahead";
     else
       est.why = "the floor-like planes have something below them nearer the user, or may be a tread";
     return lost(est);

@@ -87,6 +87,11 @@ class FloorDetector {
   bool drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame) const;
   bool stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width);
   std::vector<int> col_top_;
+  // A bigger level one riser above candidate c and another one riser below it ahead, within its
+  // width: c is a tread of a descent (its top seen cold), not the floor.
+  bool middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near);
+  std::vector<float> lateral_;
+  bool stack_below_ = false;  // middle_of_stack said so: every lower plane is a tread too
   CameraIntrinsics K_;
 
   FloorConfig cfg_;
