@@ -89,8 +89,8 @@ struct EdgeFigures {
 
 /// Runs `walk` (seed `seed`) through perception from its first frame to `end`, every `stride`-th
 /// frame before `from` (perception tracks the floor and verifies the camera height on those) and
-/// every frame after, and scores the frames from `from` on: those with the user still on the floor before the flight (truth user_step 0)
-/// and the flight expected. Every frame from `from` on, on the flight or not, must not go the wrong
+/// every frame after, and scores the frames from `from` on with the user still on the floor before
+/// the flight (truth user_step 0) and the flight expected. Every frame from `from` on, on the flight or not, must not go the wrong
 /// way or off the flight.
 EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, long end) {
   const PipelineConfig cfg;
@@ -139,6 +139,17 @@ EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, lo
   return f;
 }
 
+/// The staircase found at the edge is where it is (first edge within 3 cm, riser 1 cm, tread 2 cm,
+/// the first seen level's step number right) and nothing goes the wrong way or off the flight.
+void expect_placed_right(const EdgeFigures& f) {
+  EXPECT_LE(f.worst_origin, 0.03f);
+  EXPECT_LE(f.worst_riser, 0.01f);
+  EXPECT_LE(f.worst_tread, 0.02f);
+  EXPECT_EQ(f.wrong_index, 0);
+  EXPECT_EQ(f.wrong_direction, 0);
+  EXPECT_EQ(f.false_positive, 0);
+}
+
 // Before the lean, every approach walk lost the staircase for 5-8 frames here: the camera had
 // moved 4-9 cm towards the first step (half a riser by the time the feet reach the edge), more
 // than the 4 cm perception keeps a tracked floor by and the floorless route places a first level
@@ -148,12 +159,7 @@ TEST(StairsEdge, TopOfADescent) {
   ASSERT_GE(f.scored, 8) << "the walk should reach the edge with the feet on the floor";
   EXPECT_EQ(f.tp, f.scored) << "a descending staircase lost at its top edge";
   EXPECT_GE(f.lean, 5) << "the frames at the edge go through the lean";
-  EXPECT_LE(f.worst_origin, 0.03f);
-  EXPECT_LE(f.worst_riser, 0.01f);
-  EXPECT_LE(f.worst_tread, 0.02f);
-  EXPECT_EQ(f.wrong_index, 0);
-  EXPECT_EQ(f.wrong_direction, 0);
-  EXPECT_EQ(f.false_positive, 0);
+  expect_placed_right(f);
 }
 
 TEST(StairsEdge, FootOfAClimb) {
@@ -164,12 +170,7 @@ TEST(StairsEdge, FootOfAClimb) {
   // vote refuses the stack (in the held-out sweep's baseline too).
   EXPECT_GE(f.tp, f.scored - 1) << "an ascending staircase lost at its foot";
   EXPECT_GE(f.lean, 4) << "the frames at the edge go through the lean";
-  EXPECT_LE(f.worst_origin, 0.03f);
-  EXPECT_LE(f.worst_riser, 0.01f);
-  EXPECT_LE(f.worst_tread, 0.02f);
-  EXPECT_EQ(f.wrong_index, 0);
-  EXPECT_EQ(f.wrong_direction, 0);
-  EXPECT_EQ(f.false_positive, 0);
+  expect_placed_right(f);
 }
 
 }  // namespace
