@@ -13,6 +13,7 @@
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
+#include "synth_stairs_test_util.hpp"
 #include "test_stairs_scene.hpp"
 
 namespace {
@@ -93,18 +94,12 @@ struct EdgeFigures {
 /// the flight (truth user_step 0) and the flight expected. Every frame from `from` on, on the flight or not, must not go the wrong
 /// way or off the flight.
 EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, long end) {
-  const PipelineConfig cfg;
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult r;
-  RgbdFrame frame;
-  FrameTruth truth;
+  sgtest::SynthStairs p;
+  const SceneResult& scene = p.scene;
+  const FrameTruth& truth = p.truth;
   EdgeFigures f;
   for (long i = 0; i <= end; i += i < from ? stride : 1) {
-    synth::render_preset_frame(walk, i, seed, synth::SynthOptions{}, frame, truth);
-    perception.process(frame, scene);
-    stage.run(scene, frame.intrinsics, r);
+    const StairResult& r = p.step(walk, i, seed);
     if (i < from) continue;
     const StairFrameEval e = evaluate_stair_frame(r, truth);
     f.wrong_direction += e.wrong_direction;
@@ -118,7 +113,7 @@ EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, lo
       continue;
     }
     ++f.tp;
-    f.lean += stage.floorless_trace().lean > 0.f && !scene.floor_found;
+    f.lean += p.stage.floorless_trace().lean > 0.f && !scene.floor_found;
     const StairTruth& t = truth.stairs[0];
     // The first edge (origin of S: the floor's edge descending, the first nosing ascending), where
     // it lies even out of view; riser, tread, and the first seen level's step number.

@@ -10,6 +10,7 @@
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
+#include "synth_stairs_test_util.hpp"
 #include "test_stairs_scene.hpp"
 
 namespace {
@@ -318,18 +319,12 @@ TEST(StairsFloorless, StackOffTheRememberedFeetIsNoStaircase) {
 // the floor leaves the view; perception remembers the camera height and the floorless route places
 // the steps from the feet.
 TEST(StairsFloorless, ArrivalAtTheFootOfAClimb) {
-  const PipelineConfig cfg = on();
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult r;
-  RgbdFrame frame;
-  FrameTruth truth;
+  sgtest::SynthStairs p(on());
+  const SceneResult& scene = p.scene;
+  const FrameTruth& truth = p.truth;
   int floorless = 0, expected = 0, tp = 0, off_edge = 0, wrong_direction = 0, remembered = 0;
   for (long i = 0; i <= 212; ++i) {
-    synth::render_preset_frame("ascending_approach_climb", i, 5u, synth::SynthOptions{}, frame, truth);
-    perception.process(frame, scene);
-    stage.run(scene, frame.intrinsics, r);
+    const StairResult& r = p.step("ascending_approach_climb", i, 5u);
     if (scene.floor_found) continue;
     const StairFrameEval e = evaluate_stair_frame(r, truth);
     if (e.outcome == EvalOutcome::kSkipped) continue;  // on the first step: traversal's
@@ -341,8 +336,8 @@ TEST(StairsFloorless, ArrivalAtTheFootOfAClimb) {
     wrong_direction += e.wrong_direction;
     if (e.outcome != EvalOutcome::kTP)
       std::printf("frame %ld: %s, %s (levels %d, first index %d, first level %.3f m from the feet)\n", i,
-                  to_string(e.outcome), to_string(r.verdict), r.levels, stage.floorless_trace().first_index,
-                  stage.floorless_trace().first_offset);
+                  to_string(e.outcome), to_string(r.verdict), r.levels, p.stage.floorless_trace().first_index,
+                  p.stage.floorless_trace().first_offset);
   }
   std::printf("arrival without floor: %d frames, %d expected, %d found (%d from the remembered floor), %d off the "
               "edge, %d wrong direction\n",

@@ -11,6 +11,7 @@
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
+#include "synth_stairs_test_util.hpp"
 
 namespace {
 
@@ -38,14 +39,9 @@ void expect_descending(const StairResult& r, const FrameTruth& truth, const std:
 
 /// One static view, perception cold (as the sweep runs them).
 void run_view(const char* preset, long view, std::uint32_t seed, StairResult& r, FrameTruth& truth) {
-  const PipelineConfig cfg;
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  RgbdFrame frame;
-  SceneResult scene;
-  synth::render_preset_frame(preset, view, seed, synth::SynthOptions{}, frame, truth);
-  perception.process(frame, scene);
-  stage.run(scene, frame.intrinsics, r);
+  sgtest::SynthStairs p;
+  r = p.step(preset, view, seed, /*cold=*/true);
+  truth = p.truth;
 }
 
 // Seed 2's walk stops at the top edge of a descending flight with a person standing on it; the
@@ -56,20 +52,14 @@ void run_view(const char* preset, long view, std::uint32_t seed, StairResult& r,
 TEST(StairsPeople, DescendingWalkWithPersonOnTheFlight) {
   constexpr std::uint32_t kSeed = 2;
   constexpr long kFirstScored = 204, kLast = 239, kStride = 5;  // 14 of this stretch's 36 frames failed
-  const PipelineConfig cfg;
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  RgbdFrame frame;
-  FrameTruth truth;
-  SceneResult scene;
-  StairResult r;
+  sgtest::SynthStairs p;
+  const FrameTruth& truth = p.truth;
   int scored = 0, tp = 0;
   // Every frame from the start goes through perception: the floor is tracked as in use.
   for (long i = 0; i <= kLast; ++i) {
-    synth::render_preset_frame("descending_people_approach", i, kSeed, synth::SynthOptions{}, frame, truth);
-    perception.process(frame, scene);
+    p.perceive("descending_people_approach", i, kSeed);
     if (i < kFirstScored) continue;
-    stage.run(scene, frame.intrinsics, r);
+    const StairResult& r = p.stairs();
     // Scored frames: a stride, plus the frames that failed before the fix.
     if ((i - kFirstScored) % kStride != 0 && i != 207 && i != 213 && i != 223 && i != 238) continue;
     ++scored;

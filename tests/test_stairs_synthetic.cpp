@@ -14,6 +14,7 @@
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
+#include "synth_stairs_test_util.hpp"
 
 namespace {
 
@@ -106,23 +107,15 @@ Cause cause_of(const StairFrameEval& e, const StairResult& r, const SceneResult&
 
 Suite run_suite() {
   Suite out;
-  const PipelineConfig cfg;
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult result;
-  RgbdFrame frame;
-  FrameTruth truth;
-  const synth::SynthOptions opt;
+  sgtest::SynthStairs pipe;
+  const SceneResult& scene = pipe.scene;
+  const FrameTruth& truth = pipe.truth;
   for (const auto& p : synth::presets()) {
     const bool sequence = p.default_frames > 1;
     const long count = sequence ? p.default_frames : kStaticFrames;
-    perception.reset();
+    // Static presets: independent views; a walk starts from nothing and is then tracked.
     for (long i = 0; i < count; ++i) {
-      synth::render_preset_frame(p.name, i, kSeed, opt, frame, truth);
-      if (!sequence) perception.reset();  // independent views
-      perception.process(frame, scene);
-      stage.run(scene, frame.intrinsics, result);
+      const StairResult& result = pipe.step(p.name, i, kSeed, /*cold=*/!sequence || i == 0);
       ++out.processed[p.name];
       if (sequence && i % kSequenceStride != 0) continue;
       const StairFrameEval e = evaluate_stair_frame(result, truth);
@@ -340,22 +333,13 @@ TEST(StairsSynthetic, Suite) {
 // the strip past its edge's shadow is placed on its edge. Every view of the single-step, curb,
 // shelves and low-platform presets of seeds 6 and 7, taken cold.
 TEST(StairsSynthetic, SingleLevelsOnOtherSeeds) {
-  const PipelineConfig cfg;
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult r;
-  RgbdFrame frame;
-  FrameTruth truth;
+  sgtest::SynthStairs p;
   std::map<std::string, std::array<int, 4>> tally;  // tp, fn, fp (incl. off the edge), wrong way
   for (std::uint32_t seed : {6u, 7u}) {
     for (const char* preset : {"single_step_static", "curb_static", "shelves_static", "low_platform_static"}) {
       for (long i = 0; i < kStaticFrames; ++i) {
-        synth::render_preset_frame(preset, i, seed, synth::SynthOptions{}, frame, truth);
-        perception.reset();
-        perception.process(frame, scene);
-        stage.run(scene, frame.intrinsics, r);
-        const StairFrameEval e = evaluate_stair_frame(r, truth);
+        const StairResult& r = p.step(preset, i, seed, /*cold=*/true);
+        const StairFrameEval e = evaluate_stair_frame(r, p.truth);
         auto& t = tally[preset];
         t[0] += e.outcome == EvalOutcome::kTP;
         t[1] += e.outcome == EvalOutcome::kFN;

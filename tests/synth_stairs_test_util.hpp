@@ -1,0 +1,45 @@
+#pragma once
+// The synthetic world through perception and the stairs stage, one frame at a time as in use:
+// the set-up the stairs tests on rendered frames share.
+
+#include <cstdint>
+#include <string>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stairs.hpp"
+
+namespace sgtest {
+
+struct SynthStairs {
+  explicit SynthStairs(const stairguide::PipelineConfig& config = stairguide::PipelineConfig{})
+      : cfg(config), perception(cfg), stage(cfg) {}
+
+  /// Renders frame `i` of `preset` (seed `seed`) and runs perception on it, from nothing when
+  /// `cold` (an independent view), else tracking from the frames before.
+  void perceive(const std::string& preset, long i, std::uint32_t seed, bool cold = false) {
+    stairguide::synth::render_preset_frame(preset, i, seed, stairguide::synth::SynthOptions{}, frame, truth);
+    if (cold) perception.reset();
+    perception.process(frame, scene);
+  }
+  /// The stairs stage on the last frame perceived.
+  const stairguide::StairResult& stairs() {
+    stage.run(scene, frame.intrinsics, result);
+    return result;
+  }
+  /// Both.
+  const stairguide::StairResult& step(const std::string& preset, long i, std::uint32_t seed, bool cold = false) {
+    perceive(preset, i, seed, cold);
+    return stairs();
+  }
+
+  stairguide::PipelineConfig cfg;
+  stairguide::Perception perception;
+  stairguide::StairStage stage;
+  stairguide::RgbdFrame frame;
+  stairguide::FrameTruth truth;
+  stairguide::SceneResult scene;
+  stairguide::StairResult result;
+};
+
+}  // namespace sgtest
