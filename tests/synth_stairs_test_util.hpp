@@ -42,4 +42,13 @@ struct SynthStairs {
   stairguide::StairResult result;
 };
 
+/// One independent view (perception from nothing, as `stairguide eval` runs static presets): the
+/// stairs stage's result and the frame's truth.
+inline void run_view(const char* preset, long view, std::uint32_t seed, stairguide::StairResult& r,
+                     stairguide::FrameTruth& truth) {
+  SynthStairs p;
+  r = p.step(preset, view, seed, /*cold=*/true);
+  truth = p.truth;
+}
+
 }  // namespace sgtest

@@ -37,12 +37,7 @@ void expect_descending(const StairResult& r, const FrameTruth& truth, const std:
   }
 }
 
-/// One static view, perception cold (as the sweep runs them).
-void run_view(const char* preset, long view, std::uint32_t seed, StairResult& r, FrameTruth& truth) {
-  sgtest::SynthStairs p;
-  r = p.step(preset, view, seed, /*cold=*/true);
-  truth = p.truth;
-}
+using sgtest::run_view;
 
 // Seed 2's walk stops at the top edge of a descending flight with a person standing on it; the
 // first two treads are under the view. A ~200 px sliver at the stairwell's left rim, 1.27 risers

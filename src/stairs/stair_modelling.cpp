@@ -20,6 +20,7 @@ constexpr float kLandingDepth = 0.6f;     // m, a level deeper than this is a la
 constexpr float kShallowFloor = 0.5f;     // m, less floor than this in front of the steps is suspect
 constexpr int kDoubtfulPixels = 200;      // px, a level this big one riser below the floor
 constexpr float kOtherFloorWidth = 1.5f;  // m, a level this wide running out of view is no furniture
+constexpr float kRiserMinShare = 0.15f;   // a riser spans at least this share of the staircase's width
 constexpr float kBigLevel = 4.f;          // a level this many times the median level's area is no step (axes)
 constexpr float kBoundaryBin = 0.05f;     // m, lateral bins of the boundary line of a single level
 constexpr float kBoundaryInlier = 0.015f;  // m, a bin on the boundary line
@@ -289,22 +290,55 @@ bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& x
   // surface. One panel is enough: the other is often hidden behind the board or out of view. (A
   // step between walls looks the same; this is only asked of a level seen too shallow for a step
   // platform, which was an obstacle anyway before its far side was taken as running out of view.)
+  // Seen far away as a strip under the image top, the panel's upper part is out of view: a panel
+  // at a lateral end that faces the level's middle (its inner face: a platform's own side faces
+  // outwards) bounds the level whatever its height seen, and so does the front edge of a panel, a
+  // narrow upright facing the user across the level's end and rising above it. Such a strip may
+  // still be a step between walls: it is only "not yet sure", the user comes nearer. Both stand
+  // flush with the level's front (a wall beside a flight runs on before it, a post stands behind
+  // the nosing): a flight's first tread seen alone between walls stays a step.
   constexpr float kEndSlack = 0.10f;   // m, a panel this near the level's lateral end bounds it
   constexpr float kPanelRise = 0.05f;  // m, a panel reaching this far above the level is furniture
+  constexpr float kPostWidth = 0.15f;  // m, an upright facing the user this narrow is a panel's edge
+  constexpr float kPostSlack = 0.03f;  // m, slack on a panel being flush with the level's front or end
   const float sin_vert = std::sin(cls_.parallel_threshold), cos_side = std::cos(cls_.parallel_threshold);
+  const float cos_diag = std::sqrt(0.5f);  // faces more along the edge than towards the user
   for (const PlaneRegion& r : scene.regions) {
-    if (r.points.size() < 20 || std::fabs(r.normal.dot(up)) > sin_vert || std::fabs(r.normal.dot(xs)) < cos_side) continue;
-    const float a = xs.dot(r.centroid) - a_mid;
-    if (std::fabs(a - o.lateral_min) >= kEndSlack && std::fabs(a - o.lateral_max) >= kEndSlack) continue;
-    float top = -1e9f, b_lo = 1e9f, b_hi = -1e9f;
+    if (r.points.size() < 20 || std::fabs(r.normal.dot(up)) > sin_vert) continue;
+    const float nx = r.normal.dot(xs), nz = r.normal.dot(zs);
+    const bool side = std::fabs(nx) >= cos_diag, front = std::fabs(nz) >= cos_side;
+    if (!side && !front) continue;
+    float top = -1e9f, b_lo = 1e9f, b_hi = -1e9f, a_lo = 1e9f, a_hi = -1e9f;
     const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 200);
     for (std::size_t i = 0; i < r.points.size(); i += stride) {
       top = std::max(top, up.dot(r.points[i]) - plane);
-      const float b = zs.dot(r.points[i]) - edge_b;
+      const float b = zs.dot(r.points[i]) - edge_b, a = xs.dot(r.points[i]) - a_mid;
       b_lo = std::min(b_lo, b);
       b_hi = std::max(b_hi, b);
+      a_lo = std::min(a_lo, a);
+      a_hi = std::max(a_hi, a);
     }
-    if (top >= kPanelRise && b_hi >= o.depth_min && b_lo <= o.depth_max) return true;
+    if (side) {
+      const float a = xs.dot(r.centroid) - a_mid;
+      const bool at_min = std::fabs(a - o.lateral_min) < kEndSlack, at_max = std::fabs(a - o.lateral_max) < kEndSlack;
+      if (!at_min && !at_max) continue;
+      if (b_hi < o.depth_min || b_lo > o.depth_max) continue;
+      // Facing the level's middle: at the x_S-high end the normal points to -x_S, and vice versa;
+      // and flush with the level's front, as a shelf's side panel is with its bottom board (a wall
+      // beside a flight whose first tread alone is in view runs on before the step).
+      const bool inward = ((at_max && nx < 0.f) || (at_min && nx > 0.f)) && b_lo >= o.depth_min - kPostSlack;
+      if ((std::fabs(nx) >= cos_side && top >= kPanelRise) || inward) return true;
+    } else {
+      if (a_hi - a_lo > kPostWidth || top < kPanelRise) continue;
+      // At the level's front, as a panel's edge is flush with its board (a handrail post stands
+      // on the tread, behind its nosing).
+      if (std::fabs(b_lo - o.depth_min) > kPostSlack) continue;
+      // Across the level's end, reaching over it (the board's end lies behind the panel's edge):
+      // a wall's end or a post beside the level, wholly outside it, does not bound it.
+      const bool at_max = a_lo < o.lateral_max && a_hi >= o.lateral_max - kPostSlack;
+      const bool at_min = a_hi > o.lateral_min && a_lo <= o.lateral_min + kPostSlack;
+      if (at_min || at_max) return true;
+    }
   }
   return false;
 }
@@ -528,7 +562,17 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     };
     const Eigen::Vector2f other(-z2.y(), z2.x());
     if (overlap(other) < overlap(z2)) z2 = other;
-    if (z2.dot(levels_[static_cast<std::size_t>(n)].centroid - levels_[1].centroid) < 0.f) z2 = -z2;
+    // Which way: the levels follow one another along z_S. Most consecutive pairs must agree: one
+    // odd level (a landing's piece beside the flight, a big level at the end whose centroid the
+    // image border pulls back) turned a whole held-out flight round, its treads negative. On a
+    // tie, the first and last levels decide.
+    int ahead = 0;
+    for (int k = 1; k < n; ++k) {
+      const float d = z2.dot(levels_[static_cast<std::size_t>(k + 1)].centroid - levels_[static_cast<std::size_t>(k)].centroid);
+      ahead += d > 0.f ? 1 : (d < 0.f ? -1 : 0);
+    }
+    if (ahead < 0 || (ahead == 0 && z2.dot(levels_[static_cast<std::size_t>(n)].centroid - levels_[1].centroid) < 0.f))
+      z2 = -z2;
   } else {
     // One level: the axis direction closest to the way from the user to it.
     const Eigen::Vector2f to_level = levels_[1].centroid;
@@ -699,7 +743,8 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   // faces the user and is measured over many pixels. Ascending only (a descending flight turns its
   // risers away). The riser plane lies a nosing (a few cm) before the edge; where the tread's
   // edge lies beyond its riser by more than that, the riser (plus the nosing measured on the
-  // levels where both agree) stands for the edge. A riser only ever moves an edge nearer.
+  // levels where both agree) stands for the edge. A riser moves an edge nearer, and further only
+  // where the tread took in the riser's top rows (far views, below).
   if (dir > 0 && n >= 2) {
     riser_at_.assign(static_cast<std::size_t>(n + 1), std::numeric_limits<float>::quiet_NaN());
     riser_n_.assign(static_cast<std::size_t>(n + 1), 0);
@@ -730,17 +775,39 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
       const auto mid_a = a_.begin() + static_cast<long>(a_.size() / 2);
       std::nth_element(a_.begin(), mid_a, a_.end());
       if (*mid_a < a_min || *mid_a > a_max) continue;  // beside the staircase (a wall's end, a door)
+      // A riser runs across the staircase: an upright as narrow as a post or a stringer's facet at
+      // one end (open risers, handrail posts) is no riser, and would put a step's start in the
+      // middle of the tread below (held-out open-riser flights: treads measured 13-18 cm).
+      const auto a_ext = std::minmax_element(a_.begin(), a_.end());
+      if (*a_ext.second - *a_ext.first < kRiserMinShare * (a_max - a_min)) continue;
       const auto mid_b = b_.begin() + static_cast<long>(b_.size() / 2);
       std::nth_element(b_.begin(), mid_b, b_.end());
       const float pos = *mid_b;
-      // It must stand between the previous tread's start and its own tread's (seen) edge.
+      // It must stand between the previous tread's start and its own tread's (seen) edge, or,
+      // beyond that edge, where the tread below is seen to end (a tread is seen up to the riser
+      // that closes it) and before the tread's own far part. Far away (3 m and more), the top
+      // rows of a riser join the tread above, and moved along their rays onto its plane they pull
+      // its near edge 7-11 cm towards the user: held-out approach walks measured 18-22 cm treads.
       const StairLevel& lk = out.level_data[static_cast<std::size_t>(k)];
-      if (pos > lk.edge + cfg_.edge_max_residual) continue;
+      if (pos > lk.edge + cfg_.edge_max_residual) {
+        if (k == 1) continue;
+        const StairLevel& below = out.level_data[static_cast<std::size_t>(k - 1)];
+        if (std::fabs(pos - below.depth_max) > cfg_.edge_max_residual || pos > lk.depth_max - 0.1f) continue;
+      }
       if (k > 1 && pos < out.level_data[static_cast<std::size_t>(k - 1)].depth_min + 0.1f) continue;
       if (static_cast<int>(r.points.size()) > riser_n_[static_cast<std::size_t>(k)]) {
         riser_n_[static_cast<std::size_t>(k)] = static_cast<int>(r.points.size());
         riser_at_[static_cast<std::size_t>(k)] = pos;
       }
+    }
+    // A riser beyond its tread's seen edge places that step's start only where the step below
+    // starts at its riser too: a nosed tread measured from its nosing next to one placed at its
+    // riser would be a nosing long (7 cm on a held-out flight whose first riser was not seen).
+    for (int k = 2; k <= n; ++k) {
+      const float rk = riser_at_[static_cast<std::size_t>(k)];
+      if (rk > out.level_data[static_cast<std::size_t>(k)].edge + cfg_.edge_max_residual &&
+          !std::isfinite(riser_at_[static_cast<std::size_t>(k - 1)]))
+        riser_at_[static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
     }
     // Nosing: the edge-to-riser offset where both agree (0 when none does).
     constexpr float kMaxNosing = 0.05f;
@@ -756,14 +823,16 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     }
     // Seen nearer the horizontal than the vertical, the risers face the camera more than the
     // treads do and are the better measure of every step's start; otherwise a riser replaces only
-    // an edge that lies beyond it by more than a nosing (the tread's near rows hidden).
+    // an edge that lies beyond it by more than a nosing (the tread's near rows hidden), or before
+    // it by more than an edge's slack (the riser's top rows taken into the tread).
     const Eigen::Vector3f ray = (xs * 0.5f * (a_min + a_max) + up * levels_[1].plane +
                                  zs * out.level_data[1].edge).normalized();
     const bool grazing = std::fabs(ray.dot(zs)) > std::fabs(ray.dot(up));
     for (int k = 1; k <= n; ++k) {
       StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
       const float rk = riser_at_[static_cast<std::size_t>(k)];
-      if (std::isfinite(rk) && (grazing || o.edge - rk > kMaxNosing)) o.edge = rk + nosing;
+      if (std::isfinite(rk) && (grazing || o.edge - rk > kMaxNosing || rk - o.edge > cfg_.edge_max_residual))
+        o.edge = rk + nosing;
     }
   }
 

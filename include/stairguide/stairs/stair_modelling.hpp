@@ -20,7 +20,10 @@
 ///   two low quantiles, which is unbiased for evenly spread points and insensitive to a few
 ///   strays. Ascending, the risers
 ///   facing the user place the edges in grazing views, and replace an edge whose tread's near rows
-///   are hidden (one lying more than a nosing beyond its riser).
+///   are hidden (one lying more than a nosing beyond its riser) or whose tread took in the riser's
+///   top rows (one lying before its riser by more than edge_max_residual, the riser where the tread
+///   below is seen to end and the step below placed by its riser too). A riser spans at least 15%
+///   of the staircase's width (a post or a stringer is none).
 /// - Tread: slope of the edge positions against the step index (edge to edge); riser: slope of the
 ///   level heights (centroid to centroid, the floor included); width: lateral extent of all steps.
 ///   The step index is LevelSeed::index, so steps hidden under the view (detection's hidden first

@@ -1,0 +1,118 @@
+// Stair modelling on cold views from the held-out sweep (static presets, seeds 1-12, not the
+// suite's 5): a shelf's bottom board seen as a strip under the image top is no single step; the
+// treads of open-riser, nosed, rotated and far flights are measured as built, not short.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/stairs/stairs.hpp"
+#include "synth_stairs_test_util.hpp"
+
+namespace {
+
+using namespace stairguide;
+
+using sgtest::run_view;
+
+std::string name(const char* preset, std::uint32_t seed, long view) {
+  return std::string(preset) + " seed " + std::to_string(seed) + " #" + std::to_string(view);
+}
+
+/// An ascending flight found where it is, its tread as built (within 2 cm).
+void expect_ascending(const char* preset, std::uint32_t seed, long view) {
+  StairResult r;
+  FrameTruth truth;
+  run_view(preset, view, seed, r, truth);
+  const std::string what = name(preset, seed, view);
+  const StairFrameEval e = evaluate_stair_frame(r, truth);
+  ASSERT_TRUE(r.detected) << what << ": " << to_string(r.verdict) << ", tread " << r.tread_m << " m";
+  EXPECT_EQ(e.outcome, EvalOutcome::kTP) << what;
+  EXPECT_FALSE(e.wrong_direction) << what;
+  EXPECT_EQ(r.kind, StairKind::kAscending) << what;
+  ASSERT_TRUE(e.has_tread) << what;
+  EXPECT_LT(std::fabs(e.tread_err), 0.02f) << what << ": tread " << r.tread_m << " m";
+  if (e.has_riser) {
+    EXPECT_LT(std::fabs(e.riser_err), 0.01f) << what;
+  }
+}
+
+}  // namespace
+
+// Far away (2.2-2.3 m), the bottom board of a shelf shows only as a strip under the image top,
+// 10-18 cm high; the side panels' upper parts are out of view, so no panel was seen rising above
+// the board and it was reported as a single step. The inner face of a panel at a lateral end
+// (seed 2: facing the board's middle, seen below the board; seed 12: turned 37 degrees), or a
+// panel's front edge rising above the board at its end (seed 11), now bounds it: furniture.
+TEST(StairsHeldout, ShelfBoardUnderTheImageTopIsNoStep) {
+  const struct {
+    std::uint32_t seed;
+    long view;
+  } views[] = {{2, 20}, {11, 15}, {12, 23}};
+  for (const auto& v : views) {
+    StairResult r;
+    FrameTruth truth;
+    run_view("shelves_static", v.view, v.seed, r, truth);
+    EXPECT_FALSE(r.detected) << name("shelves_static", v.seed, v.view) << ": " << to_string(r.kind) << ", "
+                             << r.levels << " levels";
+  }
+}
+
+// The same kind of strip that is a step platform or a curb stays one: over seeds 1-12 (even
+// views, to keep the test short) every single step and curb found before the rule above is still
+// found (many are far strips under the image top, 0.06-0.5 m seen, 1.9-2.9 m away), and no shelf
+// board is reported as one.
+TEST(StairsHeldout, StepStripsStaySteps) {
+  const struct {
+    const char* preset;
+    int min_tp;  // found before the panel rule (and after): 118 of 144, 120 of 144
+  } presets[] = {{"single_step_static", 118}, {"curb_static", 120}, {"shelves_static", 0}};
+  for (const auto& p : presets) {
+    int tp = 0, fp = 0, wrong_way = 0;
+    for (std::uint32_t seed = 1; seed <= 12; ++seed) {
+      for (long view = 0; view < 24; view += 2) {
+        StairResult r;
+        FrameTruth truth;
+        run_view(p.preset, view, seed, r, truth);
+        const StairFrameEval e = evaluate_stair_frame(r, truth);
+        tp += e.outcome == EvalOutcome::kTP ? 1 : 0;
+        fp += e.outcome == EvalOutcome::kFP ? 1 : 0;
+        wrong_way += e.wrong_direction ? 1 : 0;
+      }
+    }
+    std::printf("%-20s seeds 1-12, even views: TP %d FP %d wrong direction %d\n", p.preset, tp, fp, wrong_way);
+    EXPECT_EQ(fp, 0) << p.preset;
+    EXPECT_EQ(wrong_way, 0) << p.preset;
+    EXPECT_GE(tp, p.min_tp) << p.preset;
+  }
+}
+
+// Open risers: a handrail post or a stringer's facet at one end of the flight, upright and
+// facing the user between two treads' heights, was taken for the second riser and put the
+// second step's start in the middle of the first tread (treads measured 13-18 cm). A riser
+// spans the staircase.
+TEST(StairsHeldout, OpenRisersPostIsNoRiser) {
+  expect_ascending("open_risers_static", 4, 10);
+  expect_ascending("open_risers_static", 9, 18);
+}
+
+// Far flights (2.8-3.4 m): the top rows of a riser join the tread above and, moved along their
+// rays onto its plane, pull its near edge 5-11 cm towards the user (nosed flight seed 6: 21.9 cm
+// for 30 cm). The riser beyond that edge, where the tread below is seen to end, now places it.
+TEST(StairsHeldout, FarTreadPulledByItsRiserIsPlacedByTheRiser) {
+  expect_ascending("nosing_landing_static", 6, 9);
+  expect_ascending("nosing_landing_static", 1, 19);
+}
+
+// A rotated flight whose last level is a piece of the landing beside it (or a big first level)
+// had its axis turned round by the first-to-last centroid: treads -29 to -32 cm. Most consecutive
+// levels decide the way now.
+TEST(StairsHeldout, OneOddLevelDoesNotTurnTheFlightRound) {
+  expect_ascending("rotated_static", 1, 16);
+  expect_ascending("rotated_static", 12, 12);
+}
