@@ -125,24 +125,24 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
     // sliver at its rim, and it keeps the real first step (a few cm lower or higher) out. Try the
     // other candidates as the first step, the lone level left out, and keep a flight (two levels
     // or more) if they give one. A lone level that is the only thing there stays as it was.
-    const std::vector<LevelSeed> saved_levels = hyp.levels;
-    const std::vector<char> saved_assigned = assigned_;
+    saved_levels_ = hyp.levels;
+    saved_assigned_ = assigned_;
     bool found = false;
     for (int tries = 0; tries < kMaxLoneLevels && !found; ++tries) {
-      const std::vector<char> left_out = assigned_;  // the lone levels so far stay out of the sweep
+      left_out_ = assigned_;  // the lone levels so far stay out of the sweep
       hyp.levels.resize(1);
       sweep(hyp);
       if (hyp.step_levels() >= 2) {
         for (std::size_t i = 0; i < assigned_.size(); ++i)
-          if (left_out[i]) assigned_[i] = 0;
+          if (left_out_[i]) assigned_[i] = 0;
         found = true;
       } else if (hyp.step_levels() == 0) {
         break;
       }
     }
     if (!found) {
-      hyp.levels = saved_levels;
-      assigned_ = saved_assigned;
+      hyp.levels = saved_levels_;
+      assigned_ = saved_assigned_;
     }
   }
   if (direction < 0 && floor_tracked_ && !floor.regions.empty()) {
@@ -154,13 +154,13 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
       // flight whose first treads are under the view. Try the hidden-first-steps route on the
       // other candidates; its stack (evenly spaced, a whole number of risers below the tracked
       // floor, reaching the bottom of the view) replaces the lone level.
-      const std::vector<LevelSeed> saved_levels = hyp.levels;
-      const std::vector<char> saved_assigned = assigned_;
+      saved_levels_ = hyp.levels;
+      saved_assigned_ = assigned_;
       hyp.levels.resize(1);
       std::fill(assigned_.begin(), assigned_.end(), 0);
       if (!build_hidden(hyp)) {
-        hyp.levels = saved_levels;
-        assigned_ = saved_assigned;
+        hyp.levels = saved_levels_;
+        assigned_ = saved_assigned_;
       }
     }
   }

@@ -106,6 +106,9 @@ class StairDetection {
   std::vector<int> floor_slots_;       ///< slots of floor regions
   std::vector<int> order_;
   std::vector<char> assigned_;
+  // Scratch for setting a lone first level aside (build): the sweep's state before, reused.
+  std::vector<LevelSeed> saved_levels_;
+  std::vector<char> saved_assigned_, left_out_;
   std::vector<float> dist_;
   int used_ = 0;
   bool floor_tracked_ = false;
