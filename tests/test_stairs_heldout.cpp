@@ -116,3 +116,25 @@ TEST(StairsHeldout, OneOddLevelDoesNotTurnTheFlightRound) {
   expect_ascending("rotated_static", 1, 16);
   expect_ascending("rotated_static", 12, 12);
 }
+
+// Walking up to a descent (held-out walk seed 2, frames 136-141, the last before the first step
+// down, tracked as in use): a 180 px sliver 13 cm below the first tread lay one riser below it, as
+// the whole second tread 17 cm below did; the sweep took the sliver, nearer in height, as the
+// second level, and the rest of the flight, no longer a riser apart, stayed out (2 levels, a 2 m
+// "tread": no stair). A much larger candidate in the same band now takes the level's place.
+TEST(StairsHeldout, SliverOneRiserDownDoesNotStopTheFlight) {
+  const char* walk = "descending_approach_descend";
+  sgtest::SynthStairs p;
+  for (long i = 120; i <= 141; ++i) {
+    const StairResult& r = p.step(walk, i, 2);
+    if (i < 136) continue;
+    const std::string what = name(walk, 2, i);
+    ASSERT_TRUE(r.detected) << what << ": " << to_string(r.verdict) << ", " << r.levels << " levels";
+    const StairFrameEval e = evaluate_stair_frame(r, p.truth);
+    EXPECT_EQ(e.outcome, EvalOutcome::kTP) << what;
+    EXPECT_EQ(r.kind, StairKind::kDescending) << what;
+    EXPECT_EQ(r.levels, 8) << what;
+    ASSERT_TRUE(e.has_riser) << what;
+    EXPECT_LT(std::fabs(e.riser_err), 0.01f) << what;
+  }
+}

@@ -22,6 +22,9 @@ constexpr float kStackReach = 1.0f;
 // A lone first level is set aside for another first step at most this many times (a head, then
 // the shoulders).
 constexpr int kMaxLoneLevels = 3;
+// A candidate this many times larger than another, both one riser above the last level but at
+// heights apart, takes the next level's place (see sweep).
+constexpr int kBiggerLevel = 4;
 }  // namespace
 
 StairDetection::StairDetection(const ClassificationConfig& classification, const StairDetectionConfig& config)
@@ -216,6 +219,12 @@ void StairDetection::sweep(StairHypothesis& hyp) {
         }
       }
       const float top = std::fabs(hyp.levels.back().height);
+      // Two candidates may both lie one riser above the last level, at heights apart: a sliver at
+      // a tread's nosing or a rail top 13 cm down, and the whole next tread 17 cm down. Taking the
+      // nearer in height would stop the flight there (the rest no longer a riser apart), so a much
+      // larger one nearer the riser so far takes the place (bigger_next_level) and the sliver
+      // stays out. Nearer the riser only: a far tread seen as a sliver is the next level, not the
+      // big landing 5 cm above it.
       const bool next = same < 0 && s - top >= hmin && s - top <= hmax;
       if (same < 0 && !next) continue;
       bool link = false;
@@ -227,6 +236,7 @@ void StairDetection::sweep(StairHypothesis& hyp) {
       }
       if (!link) continue;
       const int pts = static_cast<int>(c.sample.size()) * c.stride;
+      if (next && bigger_next_level(hyp, i, top, pts)) continue;
       if (same >= 0) {
         LevelSeed& l = hyp.levels[static_cast<std::size_t>(same)];
         l.height = (l.height * static_cast<float>(l.point_count) + c.height * static_cast<float>(pts)) /
@@ -244,6 +254,36 @@ void StairDetection::sweep(StairHypothesis& hyp) {
       changed = true;
     }
   }
+}
+
+bool StairDetection::bigger_next_level(const StairHypothesis& hyp, std::size_t i, float top, int pts) const {
+  const int n_levels = hyp.step_levels();
+  // The riser so far: the levels' own spacing, or the first level's height above the floor (not on
+  // the hidden-first-steps route, where that is a number of risers yet unknown).
+  float riser = 0.f;
+  if (n_levels >= 2)
+    riser = (top - std::fabs(hyp.levels[1].height)) / static_cast<float>(n_levels - 1);
+  else if (!hidden_sweep_)
+    riser = top;
+  if (riser <= 0.f) return false;
+  const float hmin = cls_.step_height_min - cfg_.height_tolerance;
+  const float hmax = cls_.step_height_max + cfg_.height_tolerance;
+  const float expected = top + riser;
+  const float s = std::fabs(pool_[static_cast<std::size_t>(order_[i])].height);
+  for (std::size_t j = 0; j < order_.size(); ++j) {
+    if (j == i || assigned_[j]) continue;
+    const Candidate& o = pool_[static_cast<std::size_t>(order_[j])];
+    const float so = std::fabs(o.height);
+    if (so - top < hmin || so - top > hmax || std::fabs(so - s) <= cfg_.same_level_tolerance) continue;
+    if (std::fabs(so - expected) >= std::fabs(s - expected)) continue;
+    if (static_cast<int>(o.sample.size()) * o.stride < kBiggerLevel * pts) continue;
+    for (int k = 0; k <= n_levels; ++k) {
+      const LevelSeed& l = hyp.levels[static_cast<std::size_t>(k)];
+      if (std::fabs(so - std::fabs(l.height)) > cfg_.connection_radius) continue;
+      if (connected(o, l)) return true;
+    }
+  }
+  return false;
 }
 
 bool StairDetection::build_hidden(StairHypothesis& hyp) {
@@ -270,7 +310,9 @@ bool StairDetection::build_hidden(StairHypothesis& hyp) {
     l.point_count = static_cast<int>(c.sample.size()) * c.stride;
     l.regions.assign(1, c.region);
     assigned_[i] = 1;
+    hidden_sweep_ = true;  // the first level's risers are not known yet
     sweep(hyp);
+    hidden_sweep_ = false;
     // The stack's own spacing is the riser; the first level seen must lie a whole number of them
     // (two or more) below the floor. One level alone says nothing of the riser.
     const int n = hyp.step_levels();

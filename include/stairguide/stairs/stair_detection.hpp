@@ -89,6 +89,10 @@ class StairDetection {
   void build(int direction, StairHypothesis& hyp);
   /// Algorithm 1's loop: adds unassigned candidates to the levels of `hyp` until nothing changes.
   void sweep(StairHypothesis& hyp);
+  /// True when an unassigned candidate other than order_[i] (`pts` points) would also be the next
+  /// level above `top` at another height nearer the riser so far, is connected to the levels, and
+  /// is kBiggerLevel times larger: the sweep then leaves order_[i] out for it.
+  bool bigger_next_level(const StairHypothesis& hyp, std::size_t i, float top, int pts) const;
   /// The hidden-first-steps route (see the file comment); true when it found a staircase.
   bool build_hidden(StairHypothesis& hyp);
   /// Ascending, when no first step touches the floor: a stack of two or more evenly spaced levels
@@ -112,6 +116,7 @@ class StairDetection {
   std::vector<float> dist_;
   int used_ = 0;
   bool floor_tracked_ = false;
+  bool hidden_sweep_ = false;  ///< build_hidden's sweep: the first level's index is provisional
   Eigen::Vector3f up_ = -Eigen::Vector3f::UnitY();  ///< floor's up, camera frame
   float view_bottom_ = 0.f;                         ///< of the current scene, see view_bottom()
   const SceneResult* scene_ = nullptr;              ///< the scene being run (only during run())
