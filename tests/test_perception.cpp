@@ -629,23 +629,25 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(Totals::get().presets, statics);
     EXPECT_EQ(A.floor_wrong_plane, 0) << "never a tread or a table taken for the floor";
     EXPECT_EQ(Totals::sequences().all.floor_wrong_plane, 0) << "never a tread below the user taken for the floor";
-    // Issue 3 asks 99 % (measured 424/428). The 4 misses are frames where a floor strip no deeper
-    // than a tread, with a tread-sized plane one riser above it, fills the bottom of the view: in
-    // one frame that is also what the first tread of a staircase looks like, and the detector says
-    // "no floor" rather than count one step too few (in use, tracking from earlier frames decides).
+    // Issue 3 asks 99 % (measured 427/428; 424/428 before a strip going on beside the flight or
+    // deeper than its treads was told from a first tread). The miss is a frame where a floor strip
+    // no deeper than a tread, with a tread one riser above it, fills the bottom of the view: in one
+    // frame that is also what the first tread of a staircase looks like, and the detector says "no
+    // floor" rather than count one step too few (in use, tracking from earlier frames decides).
     EXPECT_GE(A.floor_ok, 0.99 * A.floor_visible) << "floor found where it is visible";
     EXPECT_EQ(Totals::sequences().all.floor_ok, Totals::sequences().all.floor_visible)
         << "floor found where it is visible, walking sequences";
-    // Every tread with >= 200 pixels that keep a depth reading: 502/502 measured. 501/502 before
+    // Every tread with >= 200 pixels that keep a depth reading: 514/514 measured (502/502 before
+    // the floor was found on 3 more views of ascending flights, whose treads now count). 501/502 before
     // a tread's sliver under the shadow of the next nosing was split off its riser (nosing_landing
     // #11); 498/502 before tread/riser crease strips and tread slivers at the top border were
     // split off, and before the landing after the last riser was matched beside the flight;
     // 485/537 before thin strips were seeded on dominant directions and before the truth left out
     // tread pixels the sensor gives no depth for (grazing incidence, mixed pixels behind nosings).
-    EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 502/502)";
+    EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 208/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 211/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
     //  - walls and risers seen too small or narrow to trust (9 views), and a 450 px strip of wall
     //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
@@ -654,7 +656,8 @@ class TotalsCheck : public ::testing::Environment {
     //    shows only as a strip too narrow or too far to make a frame of its own (5 views): 4 now
     //    report no frame (a wall seen beyond the planes making it disagrees), sofa #0 is 2.08 deg
     //    off (its far wall disagrees by only 2.5 deg);
-    //  - no floor found although it is in view (4 views).
+    //  - no floor found although it is in view (1 view; 4 before the floor strip at the foot of a
+    //    flight was told from a first tread).
     // History: counted only on views reporting a frame, 143/143. On every view: 209/241 once the
     // paper's 5 % share of planar area (it refused curbs' and single steps' risers 1.3 m wide) was
     // dropped and one narrow plane, or two faces of one box, no longer made a frame; 199/226 once
@@ -662,7 +665,7 @@ class TotalsCheck : public ::testing::Environment {
     // beyond them (furniture, risers, people) voted only when the walls make no frame.
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 206) << "Manhattan frame within 2 deg where a wall or riser is in view (208/226)";
+    EXPECT_GE(A.manhattan_ok, 209) << "Manhattan frame within 2 deg where a wall or riser is in view (211/226)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }
@@ -709,9 +712,9 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     // normal (classify_regions), so every tread found has a normal within the floor's error.
     static const std::map<std::string, std::pair<int, int>> measured = {
         {"ascending_static", {51, 51}},     {"descending_static", {106, 106}},
-        {"open_risers_static", {51, 51}},   {"nosing_landing_static", {52, 52}},
+        {"open_risers_static", {51, 51}},   {"nosing_landing_static", {56, 56}},
         {"rotated_static", {53, 53}},       {"people_static", {90, 90}},
-        {"handrails_open_sides_static", {38, 38}}, {"single_step_static", {16, 16}},
+        {"handrails_open_sides_static", {46, 46}}, {"single_step_static", {16, 16}},
         {"curb_static", {7, 7}},            {"ascending_short_static", {38, 38}}};
     const auto it = measured.find(preset);
     if (it != measured.end()) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_render.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace {
@@ -74,6 +75,82 @@ TEST(PerceptionFloor, TheFirstTreadOfADescentIsNoFloor) {
           << v.preset << " " << v.index << " seed " << v.seed << ": a tread taken for the floor";
     }
   }
+}
+
+// Cold views of an ascending flight from its foot (the suite's seed) where the level strip at the
+// view's bottom, with a step rising right after it, cannot be a tread of that flight. Both were
+// refused as a possible first tread before (no floor).
+constexpr std::uint32_t kSuiteSeed = 20261123u;
+
+void expect_floor_found(const char* preset, long index, const char* cue) {
+  Perception perception{PipelineConfig{}};
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult scene;
+  synth::render_preset_frame(preset, index, kSuiteSeed, synth::SynthOptions{}, frame, truth);
+  ASSERT_TRUE(truth.floor_visible) << preset << " " << index << ": the world changed";
+  perception.process(frame, scene);
+  ASSERT_TRUE(scene.floor_found) << preset << " " << index << " (" << cue << "): " << scene.why;
+  EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f) << preset << " " << index;
+}
+
+// The floor region (2.33 m wide) goes on beside the flight (treads 1.83 m wide), past the riser
+// line of the first tread: a tread ends at the riser rising from its back, so this level is the
+// floor around the flight.
+TEST(PerceptionFloor, FloorBesideTheFlightIsNoTread) {
+  expect_floor_found("handrails_open_sides_static", 20, "level beyond the riser line, beside the flight");
+}
+
+// The floor strip is 0.39 m deep from the view's bottom to the first riser, the treads ahead
+// 0.35 m (two of them, agreeing): treads within a flight are uniform, so the strip is no tread.
+TEST(PerceptionFloor, FloorDeeperThanTheTreadsIsNoTread) {
+  expect_floor_found("nosing_landing_static", 5, "deeper than the treads ahead");
+}
+
+// The protection kept: the same two views from one riser higher and a tread and a few cm further
+// along the flight, the user still on the floor (the camera a riser higher above it): the first
+// tread now fills the bottom of the view with less depth than a tread and nothing of its level
+// beside the flight (the floor beside it is a riser lower). It must never be taken for the floor.
+TEST(PerceptionFloor, TheFirstTreadWithTheFloorOutOfViewIsRefused) {
+  Perception perception{PipelineConfig{}};
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult scene;
+  const synth::SynthOptions opt;
+  const CameraIntrinsics K = synth::synthetic_intrinsics(opt);
+  int refused = 0;
+  for (const auto& [preset, index] : {std::pair<const char*, long>{"handrails_open_sides_static", 20},
+                                      std::pair<const char*, long>{"nosing_landing_static", 5}}) {
+    synth::PresetFrame pf = synth::build_preset_frame(preset, index, kSuiteSeed, opt);
+    // The flight's direction and size, from the truth of the original view.
+    synth::render_preset_frame(preset, index, kSuiteSeed, opt, frame, truth);
+    ASSERT_FALSE(truth.stairs.empty()) << preset;
+    const StairTruth& st = truth.stairs.front();
+    ASSERT_EQ(st.kind, StairKind::kAscending) << preset;
+    const Eigen::Vector3f up_flight =
+        (pf.walker.T_world_camera.linear() * st.T_camera_stair.linear().col(2)).normalized();
+    Pose T = pf.walker.T_world_camera;
+    T.translation() += (st.tread_m + 0.05f) * up_flight + Eigen::Vector3f(0.f, 0.f, st.riser_m);
+    synth::RenderBuffers buf;
+    synth::render(pf.scene, T, K, buf, true);
+    synth::apply_depth_sensor(buf, K, opt, 7u, frame.depth);
+    synth::apply_color_sensor(buf, opt, 7u, frame.color, frame.gray);
+    frame.intrinsics = K;
+    pf.walker.T_world_camera = T;  // support_z unchanged: the user still stands on the floor
+    truth = synth::compute_truth(pf.scene, pf.walker, buf, K, opt);
+    perception.reset();
+    perception.process(frame, scene);
+    if (!scene.floor_found) {
+      ++refused;
+      continue;
+    }
+    // Only the floor itself (beside the flight) may be found; the first tread is a riser higher.
+    EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f)
+        << preset << " " << index << " shifted: the first tread taken for the floor (floor at "
+        << scene.camera_height << " m, truth " << truth.camera_height_m << " m)";
+  }
+  // The floor under the nosing view is out of view: no floor there at least.
+  EXPECT_GE(refused, 1);
 }
 
 }  // namespace

@@ -147,6 +147,87 @@ bool FloorDetector::drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame
   return columns >= 8 && dropped * 2 >= columns;
 }
 
+FloorDetector::Span FloorDetector::span(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& axis) {
+  // 0.5th and 99.5th percentiles: a region's extent along an axis, robust to stray points.
+  near_buf_.clear();
+  const std::size_t step = pts.size() > 4000 ? pts.size() / 4000 : 1;
+  for (std::size_t k = 0; k < pts.size(); k += step) near_buf_.push_back(axis.dot(pts[k]));
+  Span out;
+  out.lo = percentile(near_buf_, 5);
+  out.hi = percentile(near_buf_, 995);
+  return out;
+}
+
+bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A) {
+  // C starts at the view's edge and A, one riser above it, looks like the next tread of a flight
+  // with C its first tread (the floor under the user's feet out of view). C cannot be a tread of
+  // that flight when what is seen of it alone contradicts it, in 3D, whatever the camera's tilt:
+  //  - a tread ends at the riser rising from its back: a level seen well beyond that riser's line
+  //    (A's near edge), beside the flight's ends, is the floor or a landing around the flight;
+  //  - treads within a flight are uniform (building codes: within about a centimetre): a C whose
+  //    visible depth in front of the flight alone exceeds the depth of the treads ahead (two of
+  //    them, agreeing, so that neither is cut by the view or a person) is deeper than any tread.
+  // The flight's direction is A's short in-plane axis: a tread is far wider than deep. Nothing is
+  // concluded from a level that is not clearly a tread (A not elongated): no exemption then.
+  if (A.points.empty() || C.points.empty() || A.rect_length_minor <= 0.f ||
+      A.rect_length_major < cfg_.tread_min_aspect * A.rect_length_minor)
+    return false;
+  Eigen::Vector3f d = A.rect_axis_minor - C.normal * C.normal.dot(A.rect_axis_minor);
+  if (d.norm() < 0.5f) return false;
+  d.normalize();
+  if (d.dot(A.centroid) < 0.f) d = -d;  // away from the camera, up the flight
+  const Eigen::Vector3f side = C.normal.cross(d);
+  const Span a_d = span(A.points, d), a_s = span(A.points, side);
+
+  // Beside the flight, beyond the riser line: on C's level, C itself or another region on its
+  // plane (the floor beside a flight is often cut from the strip in front of it by a handrail's
+  // post, a newel or a shadow).
+  constexpr float kSideMargin = 0.02f;  // m, beside A's ends by more than its edge's noise
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
+  float beside = 0.f;
+  for (const PlaneRegion& L : regions) {
+    if (L.points.empty() || L.normal.dot(C.normal) < cos_par || std::fabs(L.offset - C.offset) > cfg_.inlier_distance)
+      continue;
+    const float per_point = L.area / static_cast<float>(L.points.size());
+    for (const auto& q : L.points) {
+      if (d.dot(q) <= a_d.lo + cfg_.floor_beyond_riser) continue;
+      const float t = side.dot(q);
+      if (t < a_s.lo - kSideMargin || t > a_s.hi + kSideMargin) beside += per_point;
+    }
+  }
+  if (beside >= cfg_.floor_beyond_min_area) return true;
+
+  // Deeper than the treads ahead. B: the tread after A (one riser above it, starting beyond it,
+  // in front of the same stretch of the flight).
+  auto rise_ok = [&](float rise) { return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max; };
+  const float a_depth = a_d.hi - a_d.lo;
+  bool agree = false;
+  float going = a_depth;
+  for (const PlaneRegion& B : regions) {
+    if (&B == &A || B.points.empty() || B.normal.dot(C.normal) < cos_par || !rise_ok(A.offset - B.offset)) continue;
+    const float t = side.dot(B.centroid);
+    if (t < a_s.lo || t > a_s.hi) continue;
+    const Span b_d = span(B.points, d);
+    if (b_d.lo < a_d.lo + 0.5f * a_depth) continue;  // not beyond A (a nosing overhangs A's back)
+    if (std::fabs((b_d.hi - b_d.lo) - a_depth) <= cfg_.tread_depth_agreement) {
+      agree = true;
+      going = std::max(a_depth, b_d.hi - b_d.lo);
+      break;
+    }
+  }
+  if (!agree) return false;
+  // C's depth in front of the flight: its points within A's width, short of A's middle (up to the
+  // first riser; not what an open riser shows of C's level under the flight).
+  lateral_.clear();
+  for (const auto& q : C.points) {
+    const float t = side.dot(q), x = d.dot(q);
+    if (t >= a_s.lo && t <= a_s.hi && x < a_d.lo + 0.5f * a_depth) lateral_.push_back(x);
+  }
+  if (lateral_.size() < 50) return false;
+  const float c_lo = percentile(lateral_, 5), c_hi = percentile(lateral_, 995);
+  return c_hi - c_lo > going + cfg_.floor_deeper_than_tread;
+}
+
 bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width) {
   // A plane that starts at the bottom of the view (we cannot see what the user stands on) with
   // another plane one riser above or below it starting a tread's depth further: the first tread
@@ -182,6 +263,8 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
     float a_near = 1e9f;
     for (const auto& q : A.points) a_near = std::min(a_near, foot_distance(C.normal, q));
     if (a_near - near.distance > cfg_.ambiguous_depth_max) continue;
+    // One riser above: what is seen of C may show it is no tread of that flight.
+    if (C.offset > A.offset && not_a_tread_of(regions, C, A)) continue;
     // A tread fills the view's width only as far as the staircase does: the floor usually shows
     // beside a step (columns of the image where it runs on with nothing above it). Ambiguous
     // only when nearly all of the candidate lies in image columns where the upper plane lies

@@ -138,6 +138,11 @@ struct FloorConfig {
   float ambiguous_depth_max = 0.45f; ///< m, ... and starting within this of its near edge: the candidate may be a tread
   float ambiguous_covered = 0.9f;    ///< share of such a candidate's pixels with the upper plane above them in the image
   float ambiguous_tread_area_max = 2.0f;  ///< m^2, a plane bigger than this is a floor level, never the tread after the candidate
+  float floor_beyond_riser = 0.10f;       ///< m, a candidate's level seen this far beyond the next riser's line, beside the flight ...
+  float floor_beyond_min_area = 0.02f;    ///< m^2, ... over this much area, is the floor around the flight, not its first tread
+  float floor_deeper_than_tread = 0.03f;  ///< m, a candidate deeper than the treads ahead by this is no tread of that flight
+  float tread_depth_agreement = 0.02f;    ///< m, the two treads ahead must agree in depth within this
+  float tread_min_aspect = 2.0f;          ///< a level is taken for a tread (its short axis: the flight's direction) when this many times wider than deep
   int verify_min_pixels = 400;    ///< px, this many pixels below and nearer reject a floor candidate
   int verify_stride_px = 6;       ///< px, sampling grid of the frame for the check
 
@@ -181,6 +186,16 @@ struct FloorConfig {
           "... when this share of its pixels has the upper plane above them in the image");
     v.num(ambiguous_tread_area_max, "ambiguous_tread_area_max_m2", Unit::kNone, 0.1, 100,
           "... unless that plane is bigger than this, square metres (no tread or landing is: another floor level)");
+    v.num(floor_beyond_riser, "floor_beyond_riser_cm", Unit::kCentimetre, 0, 200,
+          "such a candidate whose level goes on this far beyond the riser line of the plane above, beside the flight ...");
+    v.num(floor_beyond_min_area, "floor_beyond_min_area_m2", Unit::kNone, 0.001, 10,
+          "... over this much area (square metres) is the floor around the flight, not its first tread");
+    v.num(floor_deeper_than_tread, "floor_deeper_than_tread_cm", Unit::kCentimetre, 0, 100,
+          "such a candidate deeper in front of the flight than its treads by this is no tread of it");
+    v.num(tread_depth_agreement, "tread_depth_agreement_cm", Unit::kCentimetre, 0, 20,
+          "the two treads ahead measured for that must agree in depth within this");
+    v.num(tread_min_aspect, "tread_min_aspect", Unit::kNone, 1, 20,
+          "a level counts as a tread (its short axis the flight's direction) when this many times wider than deep");
     v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,
           "floor check: this many pixels below a candidate and nearer the user reject it (a step or seat seen from in front)");
     v.num(verify_stride_px, "verify_stride_px", Unit::kPixel, 1, 32, "floor check: sampling grid of the frame");

@@ -87,6 +87,13 @@ class FloorDetector {
   bool drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame) const;
   bool stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width);
   std::vector<int> col_top_;
+  struct Span {
+    float lo = 0.f, hi = 0.f;  // m, robust extent of points along an axis
+  };
+  Span span(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& axis);
+  // C (at the view's edge) cannot be a tread of the flight whose next tread is A, one riser above
+  // it: C's level goes on beyond A's riser line beside the flight, or C is deeper than the treads.
+  bool not_a_tread_of(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A);
   // A bigger level one riser above candidate c and another one riser below it ahead, within its
   // width: c is a tread of a descent (its top seen cold), not the floor.
   bool middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near);
