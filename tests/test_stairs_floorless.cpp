@@ -386,7 +386,9 @@ float nearest_edge(const StairResult& r, const StairTruth& t, int& k) {
 //    views of the suite where this was the miss).
 //  - A floor level in view outside the stack, a chest camera's height below and a whole number of
 //    risers from the first seen level, places the steps from the feet (the top of a descent whose
-//    first treads are self-occluded).
+//    first treads are self-occluded), and so does the floor around a stairwell that topped the
+//    stack (its near boundary farther than the first tread's below it): 4 placed views before
+//    that rule, 8 with it.
 //  - Anything else is reported `without_floor` (first step and distance unknown): its origin must
 //    still lie on one of the flight's true edges, going the right way.
 // Every view of the two approach walks is taken cold; a detection with the distance known must be
@@ -454,7 +456,7 @@ TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
   ASSERT_GE(cold, 10) << "the walks should lose the floor near the first edge";
   EXPECT_EQ(off_edge, 0) << "a staircase placed off its edges";
   EXPECT_EQ(wrong_direction, 0);
-  EXPECT_GE(placed_from_floor, 3);
+  EXPECT_GE(placed_from_floor, 7);
 }
 
 TEST(StairsFloorless, OffByConfig) {

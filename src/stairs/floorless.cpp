@@ -356,23 +356,53 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   if (static_cast<int>(chain_.size()) < std::max(2, det_.floorless_min_levels)) return;
 
   // ---- direction: do the levels rise away from the camera or towards it? ----
-  int votes_up = 0, votes_down = 0;
+  // Votes of the pairs below the top level, and the top pair's apart (see below).
+  int votes_up = 0, votes_down = 0, top_vote = 0;
   float prev = near_distance(nodes_[static_cast<std::size_t>(chain_[0])]);
   trace_.near_distances.assign(1, prev);
   for (std::size_t k = 1; k < chain_.size(); ++k) {
     const float d = near_distance(nodes_[static_cast<std::size_t>(chain_[k])]);
     trace_.near_distances.push_back(d);
-    if (d > prev + kMinRise) ++votes_up;
-    else if (d < prev - kMinRise) ++votes_down;
+    const int vote = d > prev + kMinRise ? 1 : (d < prev - kMinRise ? -1 : 0);
+    if (k + 1 == chain_.size()) top_vote = vote;
+    else if (vote > 0) ++votes_up;
+    else if (vote < 0) ++votes_down;
     prev = d;
   }
-  const int n = static_cast<int>(chain_.size());
+  int n = static_cast<int>(chain_.size());
   // Every pair must agree, but one may tie: a floor strip a few cm deep at the bottom of the view
   // ends where the first riser starts, so its near boundary and the first tread's nearly coincide.
   int dir = 0;
-  const int need = std::max(1, n - 2);
-  if (votes_down == 0 && votes_up >= need) dir = 1;
-  if (votes_up == 0 && votes_down >= need) dir = -1;
+  {
+    const int need = std::max(1, n - 2);
+    const int up_all = votes_up + (top_vote > 0 ? 1 : 0), down_all = votes_down + (top_vote < 0 ? 1 : 0);
+    if (down_all == 0 && up_all >= need) dir = 1;
+    if (up_all == 0 && down_all >= need) dir = -1;
+  }
+  // At the top of a descent seen cold, the floor around the stairwell (beside the flight, and the
+  // landing beyond its sides) lies one riser above the first tread seen and joins it at the walls'
+  // feet, so the stack takes it as its top level, while the floor under the user is out of view
+  // below the first edge. Every lower pair says descending (a higher tread lies nearer), but that
+  // level's nearest points are farther than the first tread's: no tread of the flight ahead is.
+  // A chest camera's height above it (FloorConfig range), it is the user's floor level: out of the
+  // stack, where the cold-start rule below (seen_floor_height) places the flight from it. Left in,
+  // the direction is undecided, or modelled it would be one step too many. Two descending pairs
+  // at least: one pair is no evidence (the floor strip at the foot of a short climb, seen only in a
+  // corner, lies farther than the first tread: floor, tread, landing vote down then up).
+  if (dir == 0 && n - 1 >= std::max(3, det_.floorless_min_levels) && top_vote > 0 && votes_up == 0 &&
+      votes_down >= std::max(2, n - 3)) {
+    const float cam_above = -nodes_[static_cast<std::size_t>(chain_.back())].height;
+    const float tol = det_.same_level_tolerance;
+    if (cam_above >= floor_.height_min - tol && cam_above <= floor_.height_max + tol) {
+      trace_.floor_beside = true;
+      chain_.pop_back();
+      trace_.level_heights.pop_back();
+      trace_.near_distances.pop_back();
+      n = static_cast<int>(chain_.size());
+      trace_.stacked = n;
+      dir = -1;
+    }
+  }
   trace_.direction = dir;
   out.kind = StairKind::kNone;
   out.levels = n;

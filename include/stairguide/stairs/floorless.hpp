@@ -63,7 +63,13 @@
 /// chest camera's height below the camera, FloorConfig height range, and 1..1 +
 /// `floorless_max_hidden_steps` risers from the first seen level on the user's side; the floor
 /// perception refused, e.g. at the top of a descent whose first treads are self-occluded) anchors
-/// the stack as a remembered height does (`without_floor` false, trace `floor_seen`). Otherwise
+/// the stack as a remembered height does (`without_floor` false, trace `floor_seen`). At the top of
+/// a descent the floor around the stairwell joins the first tread seen at the walls' feet and tops
+/// the stack, while the floor under the user is out of view: a top level whose nearest points lie
+/// farther from the camera's vertical than the level one riser below it (no tread of the flight
+/// ahead does), with every lower pair descending (two at least) and a chest camera's height below
+/// the camera, is taken out of the stack as that floor (trace `floor_beside`), and the rule above
+/// applies. Otherwise
 /// the result has `without_floor` set: heights are relative to the first seen level, and the
 /// distance from the user's feet and the first seen level's step number are unknown. The first
 /// level seen whose near boundary the image border cuts may be the floor the user stands on (the
@@ -101,6 +107,9 @@ struct FloorlessTrace {
   bool floor_level = false;            ///< the first seen level was taken for the floor (level 0)
   bool anchored = false;               ///< levels placed from the feet (camera height remembered or floor seen)
   bool floor_seen = false;             ///< cold start: the user's floor seen outside the stack gave the camera height
+  /// The stack's top level was the floor around a stairwell (farther than the first tread below it,
+  /// a chest camera's height below the camera): taken out of the stack, descending (see the file comment).
+  bool floor_beside = false;
   int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
   float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
   /// m, anchored: how far the chest had moved towards the flight (first_index risers less
