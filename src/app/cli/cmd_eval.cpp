@@ -79,6 +79,13 @@ struct Runner {
       if (e.outcome == EvalOutcome::kTP)
         std::printf("  riser %+.1f tread %+.1f width %+.1f edge %.1f cm yaw %.2f deg", 100 * e.riser_err,
                     100 * e.tread_err, 100 * e.width_err, 100 * e.edge_line_err, e.yaw_err_deg);
+      else if (result.levels > 0)
+        // Why a model was refused is often a measure out of the code (a 2 m "tread"), and which floor
+        // it stood on: what was measured, and the floor perception gave it.
+        std::printf("  measured riser %.1f tread %.1f width %.1f cm, floor %s (camera %.3f m, truth %.3f m)",
+                    100 * result.riser_m, 100 * result.tread_m, 100 * result.width_m,
+                    scene.floor_found ? (scene.floor_tracked ? "tracked" : "found") : "none",
+                    scene.floor_found ? scene.camera_height : 0.f, truth.camera_height_m);
       std::printf("\n");
     }
     ++index;
