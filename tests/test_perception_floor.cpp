@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/capture/synthetic_render.hpp"
@@ -151,6 +152,37 @@ TEST(PerceptionFloor, TheFirstTreadWithTheFloorOutOfViewIsRefused) {
   }
   // The floor under the nosing view is out of view: no floor there at least.
   EXPECT_GE(refused, 1);
+}
+
+// Cold view of a curb from its upper level (held-out seed 2): the user's level shows only as a
+// strip cut by the view's bottom-left corner (0.165 m above the road, too small for a floor), and
+// the road was taken for the floor (1.44 m instead of 1.275 m: the curb ahead turned upside down).
+// The strip's straight edge with the road leaves the nadir on the strip's side: no floor.
+TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
+  Perception perception{PipelineConfig{}};
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult scene;
+  synth::render_preset_frame("curb_static", 4, 2u, synth::SynthOptions{}, frame, truth);
+  perception.process(frame, scene);
+  EXPECT_FALSE(scene.floor_found) << "floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
+                                  << " m";
+  EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
+}
+
+// The protection does not reach a step beside the floor (held-out seed 3): a single step cut by
+// the view's bottom edge, 0.166 m above the floor, with a straight 1.2 m edge, but the nadir lies
+// on the floor's side of that edge (about 1 m): the user stands on the floor, which is found.
+TEST(PerceptionFloor, AStepAtTheViewsEdgeAheadKeepsTheFloor) {
+  Perception perception{PipelineConfig{}};
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult scene;
+  synth::render_preset_frame("single_step_static", 11, 3u, synth::SynthOptions{}, frame, truth);
+  ASSERT_TRUE(truth.floor_visible) << "the world changed";
+  perception.process(frame, scene);
+  ASSERT_TRUE(scene.floor_found) << scene.why;
+  EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f);
 }
 
 }  // namespace

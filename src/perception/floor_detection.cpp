@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 namespace stairguide {
 
 Pose floor_pose_from_plane(const Eigen::Vector3f& up, float camera_height) {
@@ -324,6 +326,114 @@ bool FloorDetector::middle_of_stack(const std::vector<PlaneRegion>& regions, int
   return false;
 }
 
+bool FloorDetector::level_above_underfoot(const std::vector<PlaneRegion>& regions, int c, int width, int height) {
+  // Standing on a curb (or a step, a platform) and looking down at the road beyond it, the camera
+  // may see the user's own level only as a strip along the view's bottom edge: too small for the
+  // floor, while the big lower level passes every check (nothing lower lies nearer the feet, the
+  // riser faces away). Taking that lower level for the floor puts the floor a curb too low and
+  // turns the curb ahead the wrong way (a step up instead of a step down). The user may stand on
+  // an upper level U when, in the candidate's floor frame:
+  //  - U is a curb's height above the candidate and cut by the view's bottom edge (its extent
+  //    towards the user unknown), and
+  //  - U's boundary with the candidate is a straight edge whose line leaves the nadir (the point
+  //    under the camera, the origin of the floor frame) on U's side.
+  // A crate or a step beside or ahead of the user either has its near edge inside the view or
+  // the nadir on the candidate's side of its edge (the first tread of an ascent ahead).
+  const PlaneRegion& F = regions[c];
+  if (F.points.empty() || width <= 0 || height <= 0) return false;
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
+  const Pose T = floor_pose_from_plane(F.normal, F.offset);
+  const int edge_row = height - 1 - std::max(2, height / 60);  // rows this low are the view's bottom edge
+  const float gap = std::max(cfg_.curb_boundary_gap, 0.02f);
+  const float cell = gap / 5.f;
+  const int reach_cells = 5;
+  for (std::size_t j = 0; j < regions.size(); ++j) {
+    if (static_cast<int>(j) == c) continue;
+    const PlaneRegion& U = regions[j];
+    if (U.points.size() < 30 || U.pixels.empty() || U.normal.dot(F.normal) < cos_par) continue;
+    const float rise = F.offset - U.offset;  // normals face the camera: U above F has a smaller offset
+    if (rise < cfg_.curb_rise_min || rise > cfg_.curb_rise_max) continue;
+    int lowest_row = 0;
+    for (int p : U.pixels) lowest_row = std::max(lowest_row, p / width);
+    if (lowest_row < edge_row) continue;  // its near edge is seen: it does not reach under the user
+    // U's points in F's floor frame (x, z), and their bounding box grown by the gap.
+    const std::size_t ustep = std::max<std::size_t>(1, U.points.size() / 3000);
+    float x0 = 1e9f, x1 = -1e9f, z0 = 1e9f, z1 = -1e9f;
+    std::vector<Eigen::Vector2f>& u2 = curb_u_;  // scratch, reused across frames
+    u2.clear();
+    for (std::size_t k = 0; k < U.points.size(); k += ustep) {
+      const Eigen::Vector3f q = T * U.points[k];
+      u2.emplace_back(q.x(), q.z());
+      x0 = std::min(x0, q.x()), x1 = std::max(x1, q.x()), z0 = std::min(z0, q.z()), z1 = std::max(z1, q.z());
+    }
+    x0 -= gap, z0 -= gap, x1 += gap, z1 += gap;
+    const int gw = static_cast<int>((x1 - x0) / cell) + 1, gh = static_cast<int>((z1 - z0) / cell) + 1;
+    if (gw <= 0 || gh <= 0 || static_cast<long>(gw) * gh > 4000000L) continue;
+    // F's occupancy near U, then grown by the gap (separable max): a U point on a grown cell lies
+    // within the gap of F (the riser and the strip of F it hides from view lie between them).
+    grid_.assign(static_cast<std::size_t>(gw) * gh, 0);
+    const std::size_t fstep = std::max<std::size_t>(1, F.points.size() / 8000);
+    Eigen::Vector2f f_sum(0.f, 0.f);
+    int f_n = 0;
+    for (std::size_t k = 0; k < F.points.size(); k += fstep) {
+      const Eigen::Vector3f q = T * F.points[k];
+      const int gx = static_cast<int>((q.x() - x0) / cell), gz = static_cast<int>((q.z() - z0) / cell);
+      if (q.x() < x0 || q.z() < z0 || gx >= gw || gz >= gh) continue;
+      grid_[static_cast<std::size_t>(gz) * gw + gx] = 1;
+      f_sum += Eigen::Vector2f(q.x(), q.z());
+      ++f_n;
+    }
+    if (f_n < 30) continue;
+    std::vector<unsigned char>& tmp = curb_grid_;
+    tmp.assign(grid_.size(), 0);
+    for (int gz = 0; gz < gh; ++gz)
+      for (int gx = 0; gx < gw; ++gx)
+        if (grid_[static_cast<std::size_t>(gz) * gw + gx])
+          for (int d = std::max(0, gx - reach_cells); d <= std::min(gw - 1, gx + reach_cells); ++d)
+            tmp[static_cast<std::size_t>(gz) * gw + d] = 1;
+    std::fill(grid_.begin(), grid_.end(), 0);
+    for (int gz = 0; gz < gh; ++gz)
+      for (int gx = 0; gx < gw; ++gx)
+        if (tmp[static_cast<std::size_t>(gz) * gw + gx])
+          for (int d = std::max(0, gz - reach_cells); d <= std::min(gh - 1, gz + reach_cells); ++d)
+            grid_[static_cast<std::size_t>(d) * gw + gx] = 1;
+    // U's boundary with F: its points within the gap of F.
+    Eigen::Vector2f mean(0.f, 0.f);
+    std::vector<Eigen::Vector2f>& b = curb_edge_;
+    b.clear();
+    for (const auto& q : u2) {
+      const int gx = static_cast<int>((q.x() - x0) / cell), gz = static_cast<int>((q.y() - z0) / cell);
+      if (gx < 0 || gz < 0 || gx >= gw || gz >= gh || !grid_[static_cast<std::size_t>(gz) * gw + gx]) continue;
+      b.push_back(q);
+      mean += q;
+    }
+    if (b.size() < 30) continue;
+    mean /= static_cast<float>(b.size());
+    Eigen::Matrix2f C = Eigen::Matrix2f::Zero();
+    for (const auto& q : b) C += (q - mean) * (q - mean).transpose();
+    C /= static_cast<float>(b.size());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> es(C);
+    // The boundary band is the gap deep: its rms across the edge is about gap/sqrt(12) on a
+    // straight edge, plus what bends it (a corner of a crate).
+    const float across = std::sqrt(std::max(0.f, es.eigenvalues()(0)));
+    const float along = std::sqrt(std::max(0.f, es.eigenvalues()(1)));
+    if (across > cfg_.curb_straightness + gap * 0.2887f || along < 3.f * across) continue;
+    // A curb's edge runs across the view; the corner of a platform or a crate, or the end of a
+    // landing, shows a short one (measured 0.2-0.5 m against 1.0 m or more for the curbs).
+    const Eigen::Vector2f t = es.eigenvectors().col(1);
+    near_buf_.clear();
+    for (const auto& q : b) near_buf_.push_back(t.dot(q));
+    const float t_lo = percentile(near_buf_, 20), t_hi = percentile(near_buf_, 980);
+    if (t_hi - t_lo < cfg_.curb_min_edge) continue;
+    Eigen::Vector2f m = es.eigenvectors().col(0);  // across the edge
+    const Eigen::Vector2f f_mean = f_sum / static_cast<float>(f_n);
+    if (m.dot(f_mean - mean) < 0.f) m = -m;  // towards F
+    // The nadir (origin) on U's side of the edge's line.
+    if (m.dot(-mean) < 0.f) return true;
+  }
+  return false;
+}
+
 FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame) {
   FloorEstimate est;
   const int n = static_cast<int>(regions.size());
@@ -392,6 +502,11 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     stack_below_ = false;
     const bool stair = clear && !tracked &&
                        (stair_from_view_edge(regions, chosen, near, frame.depth.cols) || middle_of_stack(regions, chosen, near));
+    // Cold, passing every other check: the user may stand on a level above it at the view's edge.
+    if (clear && !stair && !tracked && level_above_underfoot(regions, chosen, frame.depth.cols, frame.depth.rows)) {
+      est.why = "the user may stand on the level above, seen at the view's edge";
+      return lost(est);
+    }
     if (clear && !stair) {
       est.tracked = tracked;
       anchor_ = f.offset;

@@ -143,6 +143,12 @@ struct FloorConfig {
   float floor_deeper_than_tread = 0.03f;  ///< m, a candidate deeper than the treads ahead by this is no tread of that flight
   float tread_depth_agreement = 0.02f;    ///< m, the two treads ahead must agree in depth within this
   float tread_min_aspect = 2.0f;          ///< a level is taken for a tread (its short axis: the flight's direction) when this many times wider than deep
+  float curb_rise_min = 0.05f;    ///< m, a level this much above a candidate ...
+  float curb_rise_max = 0.25f;    ///< m, ... and at most this, cut by the view's bottom edge, the nadir on its side
+                                  ///< of its straight boundary with the candidate: the user may stand on it
+  float curb_boundary_gap = 0.25f;  ///< m, points of that level this near the candidate form their boundary
+  float curb_straightness = 0.04f;  ///< m, largest rms off a straight line for that boundary
+  float curb_min_edge = 0.8f;       ///< m, shortest such boundary (a curb's edge, not a crate's corner)
   int verify_min_pixels = 400;    ///< px, this many pixels below and nearer reject a floor candidate
   int verify_stride_px = 6;       ///< px, sampling grid of the frame for the check
 
@@ -196,6 +202,16 @@ struct FloorConfig {
           "the two treads ahead measured for that must agree in depth within this");
     v.num(tread_min_aspect, "tread_min_aspect", Unit::kNone, 1, 20,
           "a level counts as a tread (its short axis the flight's direction) when this many times wider than deep");
+    v.num(curb_rise_min, "curb_rise_min_cm", Unit::kCentimetre, 0, 100,
+          "cold view: a level this much or more above the floor candidate, cut by the view's bottom edge, with the "
+          "user's nadir on its side of its straight boundary with the candidate: the user may stand on it (no floor)");
+    v.num(curb_rise_max, "curb_rise_max_cm", Unit::kCentimetre, 0, 100, "... and at most this much above it");
+    v.num(curb_boundary_gap, "curb_boundary_gap_cm", Unit::kCentimetre, 1, 100,
+          "points of that level this near the candidate (in the floor plane) form their boundary");
+    v.num(curb_min_edge, "curb_min_edge_m", Unit::kMetre, 0, 10,
+          "that boundary is a curb's edge (not the corner of a platform or a crate) when at least this long");
+    v.num(curb_straightness, "curb_straightness_cm", Unit::kCentimetre, 0.1, 50,
+          "that boundary is a straight edge (a curb) when its rms off a line is at most this");
     v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,
           "floor check: this many pixels below a candidate and nearer the user reject it (a step or seat seen from in front)");
     v.num(verify_stride_px, "verify_stride_px", Unit::kPixel, 1, 32, "floor check: sampling grid of the frame");

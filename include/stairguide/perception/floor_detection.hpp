@@ -21,6 +21,9 @@
 /// floor ("no floor" is recoverable, a wrong floor hides a staircase). A plane whose near edge is
 /// the bottom of the view, with another plane one riser above it a tread's depth further, may be
 /// the first tread of a staircase filling the view: it is not taken either.
+/// A cold candidate with another level a curb's height above it (curb_rise_min..max) that is
+/// cut by the view's bottom edge and whose straight boundary with the candidate leaves the
+/// user's nadir on its side is not taken either: the user may stand on that level.
 /// Of parallel candidates, a lower one reaching as near the user's feet (angle from the nadir)
 /// wins over a higher one (a seat or a platform beside the floor).
 
@@ -97,6 +100,13 @@ class FloorDetector {
   // A bigger level one riser above candidate c and another one riser below it ahead, within its
   // width: c is a tread of a descent (its top seen cold), not the floor.
   bool middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near);
+  // Cold view: a level a curb's height above candidate c, cut by the view's bottom edge, whose
+  // straight boundary with c (measured in c's floor frame), extended, leaves the user's nadir on
+  // its side: the user may stand on that level, seen only at the view's edge.
+  bool level_above_underfoot(const std::vector<PlaneRegion>& regions, int c, int width, int height);
+  std::vector<unsigned char> grid_;
+  std::vector<unsigned char> curb_grid_;                 // level_above_underfoot scratch: the grid grown along x
+  std::vector<Eigen::Vector2f> curb_u_, curb_edge_;      // ... the upper level's points and its edge with F (floor frame x, z)
   std::vector<float> lateral_;
   bool stack_below_ = false;  // middle_of_stack said so: every lower plane is a tread too
   CameraIntrinsics K_;
