@@ -83,14 +83,20 @@ TEST(PerceptionFloor, TheFirstTreadOfADescentIsNoFloor) {
 // refused as a possible first tread before (no floor).
 constexpr std::uint32_t kSuiteSeed = 20261123u;
 
-void expect_floor_found(const char* preset, long index, const char* cue) {
+// One static view perceived from nothing (as the wearer switches the aid on).
+SceneResult cold_view(const char* preset, long index, std::uint32_t seed, FrameTruth& truth) {
   Perception perception{PipelineConfig{}};
   RgbdFrame frame;
-  FrameTruth truth;
   SceneResult scene;
-  synth::render_preset_frame(preset, index, kSuiteSeed, synth::SynthOptions{}, frame, truth);
-  ASSERT_TRUE(truth.floor_visible) << preset << " " << index << ": the world changed";
+  synth::render_preset_frame(preset, index, seed, synth::SynthOptions{}, frame, truth);
   perception.process(frame, scene);
+  return scene;
+}
+
+void expect_floor_found(const char* preset, long index, const char* cue, std::uint32_t seed = kSuiteSeed) {
+  FrameTruth truth;
+  const SceneResult scene = cold_view(preset, index, seed, truth);
+  ASSERT_TRUE(truth.floor_visible) << preset << " " << index << ": the world changed";
   ASSERT_TRUE(scene.floor_found) << preset << " " << index << " (" << cue << "): " << scene.why;
   EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f) << preset << " " << index;
 }
@@ -159,12 +165,8 @@ TEST(PerceptionFloor, TheFirstTreadWithTheFloorOutOfViewIsRefused) {
 // the road was taken for the floor (1.44 m instead of 1.275 m: the curb ahead turned upside down).
 // The strip's straight edge with the road leaves the nadir on the strip's side: no floor.
 TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
-  Perception perception{PipelineConfig{}};
-  RgbdFrame frame;
   FrameTruth truth;
-  SceneResult scene;
-  synth::render_preset_frame("curb_static", 4, 2u, synth::SynthOptions{}, frame, truth);
-  perception.process(frame, scene);
+  const SceneResult scene = cold_view("curb_static", 4, 2u, truth);
   EXPECT_FALSE(scene.floor_found) << "floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
                                   << " m";
   EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
@@ -174,15 +176,7 @@ TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
 // the view's bottom edge, 0.166 m above the floor, with a straight 1.2 m edge, but the nadir lies
 // on the floor's side of that edge (about 1 m): the user stands on the floor, which is found.
 TEST(PerceptionFloor, AStepAtTheViewsEdgeAheadKeepsTheFloor) {
-  Perception perception{PipelineConfig{}};
-  RgbdFrame frame;
-  FrameTruth truth;
-  SceneResult scene;
-  synth::render_preset_frame("single_step_static", 11, 3u, synth::SynthOptions{}, frame, truth);
-  ASSERT_TRUE(truth.floor_visible) << "the world changed";
-  perception.process(frame, scene);
-  ASSERT_TRUE(scene.floor_found) << scene.why;
-  EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f);
+  expect_floor_found("single_step_static", 11, "a step at the view's edge, the nadir on the floor's side", 3u);
 }
 
 }  // namespace
