@@ -647,9 +647,9 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 211/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 213/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
-    //  - walls and risers seen too small or narrow to trust (9 views), and a 450 px strip of wall
+    //  - walls and risers seen too small or narrow to trust (7 views), and a 450 px strip of wall
     //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
     //    world through them, see test_walk_manhattan);
     //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
@@ -662,10 +662,12 @@ class TotalsCheck : public ::testing::Environment {
     // paper's 5 % share of planar area (it refused curbs' and single steps' risers 1.3 m wide) was
     // dropped and one narrow plane, or two faces of one box, no longer made a frame; 199/226 once
     // an open riser's tread edge no longer counted as a riser; 208/226 once planes with floor
-    // beyond them (furniture, risers, people) voted only when the walls make no frame.
+    // beyond them (furniture, risers, people) voted only when the walls make no frame; 213/226 once
+    // two narrow strips of one riser or wall on one line counted as one plane as wide as they span
+    // (and a 3 cm leg beside a person's front no longer made a "parallel pair": test_perception_manhattan).
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 209) << "Manhattan frame within 2 deg where a wall or riser is in view (211/226)";
+    EXPECT_GE(A.manhattan_ok, 211) << "Manhattan frame within 2 deg where a wall or riser is in view (213/226)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }
@@ -681,7 +683,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     if (p.name == preset && p.default_frames > 1) length = p.default_frames, frames = 32;
   PresetFigures F;
   // SG_SEED=N runs the presets on another seed (the bounds below hold for the default one):
-  // measured Manhattan 213/236 on seed 7 and 230/250 on seed 8, no frame off with stairs in view.
+  // measured Manhattan 218/236 on seed 7 and 236/250 on seed 8, no frame off with stairs in view.
   const char* seed = getenv("SG_SEED");
   run_preset(preset, frames, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, length, F);
   (length <= 1 ? Totals::get() : Totals::sequences()).add(F);

@@ -190,6 +190,8 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     v.nx = nh.x();
     v.nz = nh.y();
     v.limit = nh.x() * cf.x() + nh.y() * cf.z() - cfg_.floor_beyond_margin;
+    v.cx = cf.x();
+    v.cz = cf.z();
     float floor_beyond = 0.f;
     for (const FloorSample& f : floor_pts)
       if (v.nx * f.x + v.nz * f.z < v.limit) floor_beyond += f.area;
@@ -237,7 +239,10 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
       if (bounding_only && vn.inside) continue;  // did not make this frame
       if (std::fabs(wrap_quarter(vn.a - frame.yaw)) > cfg_.cluster_tolerance) continue;
       if (std::fabs(wrap_quarter(vf.a - vn.a)) <= std::max(disagree_tolerance(vn), disagree_tolerance(vf))) continue;
-      if (area_beyond(vn, f0, f1) < cfg_.structure_beyond_area) continue;
+      // Seen beyond it: structure_beyond_area of the wall, or half of a smaller wall (a strip of
+      // wall 0.2 to 0.3 m wide seen past a sofa or shelves has 0.01 to 0.02 m^2 in view: synthetic
+      // views 9 to 14 degrees off before).
+      if (area_beyond(vn, f0, f1) < std::min(cfg_.structure_beyond_area, 0.5f * vf.area)) continue;
       est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
                 "the room in front of it)";
       est.fraction = frame.fraction;
@@ -255,6 +260,10 @@ float ManhattanTracker::disagree_tolerance(const Vote& v) const {
   return v.sliver ? std::max(cfg_.cluster_tolerance, cfg_.clipped_disagreement) : cfg_.cluster_tolerance;
 }
 
+float ManhattanTracker::min_width(const Vote& v, bool bounding_only) const {
+  return bounding_only && v.grounded ? cfg_.min_bounding_width : cfg_.min_plane_width;
+}
+
 ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float total_area, bool bounding_only) {
   ManhattanEstimate est;
   // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
@@ -263,32 +272,58 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
     if (!(bounding_only && v.inside)) hist.add(v.a, v.w);
   const float mode = hist.mode();
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
-  float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f, widest = 0.f;
+  float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f;
   bool wide = false;
-  // Two agreeing planes parallel to each other (modulo 180 degrees: two risers, two strips of one
-  // wall, a wall and a riser) are structure; two faces of one box at right angles (a person, a
-  // bin) agree modulo 90 degrees by construction and prove nothing.
-  bool parallel_pair = false;
-  std::vector<float>& headings = headings_;
-  headings.clear();
+  std::vector<const Vote*>& candidates = pair_candidates_;
+  candidates.clear();
   for (const Vote& v : votes) {
     if (bounding_only && v.inside) continue;
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
-    for (const float h : headings) {
-      float d = std::fmod(std::fabs(v.heading - h), kPi);  // modulo 180 degrees
-      d = std::min(d, kPi - d);
-      parallel_pair = parallel_pair || d <= cfg_.cluster_tolerance;
-    }
-    headings.push_back(v.heading);
     sc += v.w * std::cos(4.f * v.a);
     ss += v.w * std::sin(4.f * v.a);
     agree += v.area;
     wsum_agree += v.w;
+    // A plane seen mostly at the depth cut-off cannot make a frame of walls alone (see `clipped`).
     if (bounding_only && v.clipped) continue;
-    widest = std::max(widest, v.width);
     // A wall standing on the floor is trusted from a narrower strip than other planes: people and
     // posts, whose yaw is off by degrees, have floor beside them or do not stand at its height.
-    wide = wide || v.width >= (bounding_only && v.grounded ? cfg_.min_bounding_width : cfg_.min_plane_width);
+    wide = wide || v.width >= min_width(v, bounding_only);
+    // Pairs (below) are made of planes whose fit is not biased by the depth cut-off.
+    if (v.width >= cfg_.pair_min_width && v.has_side && !v.clipped) candidates.push_back(&v);
+  }
+  // Without a wide plane, two agreeing planes parallel to each other (modulo 180 degrees) are
+  // structure when each is wide enough for its own yaw to mean something (a person's legs and
+  // arms, 3 to 4 cm, agree with anything within degrees; risers seen at a grazing angle on a turn
+  // are 5 cm and right to a degree) and they agree tightly:
+  //  - strips of one plane (a riser or a wall cut by something in front of it) lie on one line
+  //    seen from above: the line between them is the lever arm of their yaw, and they count as
+  //    one plane as wide as they span;
+  //  - two distinct planes a tread's going or more apart (two risers, a wall and a riser).
+  // Between the two (two parts of one person a few centimetres apart, or anything not on one line
+  // with its own direction) they prove nothing. Two faces of one box at right angles (a person,
+  // a bin) agree modulo 90 degrees by construction and prove nothing either.
+  bool parallel_pair = false;
+  const float tan_pair = std::tan(cfg_.pair_tolerance);
+  for (std::size_t i = 0; i < candidates.size() && !wide; ++i) {
+    const Vote& p = *candidates[i];
+    for (std::size_t j = i + 1; j < candidates.size() && !wide; ++j) {
+      const Vote& q = *candidates[j];
+      float d = std::fmod(std::fabs(p.heading - q.heading), kPi);  // modulo 180 degrees
+      d = std::min(d, kPi - d);
+      if (d > cfg_.pair_tolerance) continue;
+      const float dx = q.cx - p.cx, dz = q.cz - p.cz;
+      const float along_normal = std::fabs(p.nx * dx + p.nz * dz);
+      const float along_plane = std::fabs(-p.nz * dx + p.nx * dz);
+      if (along_normal >= cfg_.pair_min_separation) {
+        // Two people turned alike, 10 cm strips of them, agree as well as two risers do (synthetic
+        // view, 32 degrees off): one of the two must be half a wide plane's width (a riser or a
+        // wall seen in part).
+        parallel_pair = parallel_pair || std::max(p.width, q.width) >= 0.5f * cfg_.min_plane_width;
+      } else if (along_normal <= along_plane * tan_pair) {
+        const float span = along_plane + 0.5f * (p.width + q.width);
+        wide = span >= std::max(min_width(p, bounding_only), min_width(q, bounding_only));
+      }
+    }
   }
   est.vertical_area = agree;
   est.fraction = total_area > 0.f ? agree / total_area : 0.f;
@@ -300,17 +335,18 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
     est.why = "too little vertical plane area for a Manhattan frame";
     return est;
   }
-  // A frame is trusted when a wide plane (a wall, a riser) supports it, or when narrow ones
-  // agree tightly and two of them are parallel (strips of wall at the view's edge, the risers of a
-  // flight seen in part; one narrow plane, a post or a person, agrees with itself and proves
-  // nothing). People, posts and the sides of boxes are narrow and agree only to degrees: their yaw
-  // is no frame. (The spread check alone refused most real kitchen views, whose walls and
+  // A frame is trusted when a wide plane (a wall, a riser, or strips of one on a line as wide)
+  // supports it, or when the agreeing planes agree tightly and two of them are distinct parallel
+  // planes (the risers of a flight seen in part, a wall and a riser; one narrow plane, a post or a
+  // person, agrees with itself and proves nothing, and a leg or an arm beside it no more).
+  // People, posts and the sides of boxes are narrow and agree only to degrees: their yaw is no
+  // frame. (The spread check alone refused most real kitchen views, whose walls and
   // cupboards agree only to a few degrees; the width check alone refused a corridor seen as a
   // 35 cm strip of wall.)
   const float wsum = std::max(wsum_agree, 1e-12f);
   const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
   const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
-  if (!wide && (!parallel_pair || spread > cfg_.max_spread || widest < 0.5f * cfg_.min_plane_width)) {
+  if (!wide && (!parallel_pair || spread > cfg_.max_spread)) {
     est.why = "no wide vertical plane, and the narrow ones are one, too narrow or disagree by degrees (no wall or "
               "riser in view, or too little of one to trust)";
     return est;

@@ -234,6 +234,9 @@ struct ManhattanConfig {
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
   float clipped_disagreement = 0.2617994f;  ///< rad, ... and contradicts another direction only beyond this (15 deg)
+  float pair_min_width = 0.05f;         ///< m, without a wide plane, two agreeing parallel planes each this wide ...
+  float pair_tolerance = 0.03490659f;   ///< rad, ... agreeing within this (2 deg) ...
+  float pair_min_separation = 0.15f;    ///< m, ... make the frame trusted when this far apart (two risers, a wall and a riser) ...
   float carry_seconds = 10.f;         ///< s, a Manhattan frame seen this recently is carried by the odometry to views that make none (0: never)
 
   template <class V> void visit(V& v) {
@@ -272,6 +275,14 @@ struct ManhattanConfig {
     v.num(clipped_disagreement, "clipped_disagreement_deg", Unit::kDegree, 0.5, 45,
           "a sliver contradicts another direction, modulo 90 deg, only when it differs by more than this (other "
           "planes: cluster_tolerance)");
+    v.num(pair_min_width, "pair_min_width_cm", Unit::kCentimetre, 0, 1000,
+          "without a wide vertical plane, two agreeing parallel planes each at least this wide (in the walls' frame: "
+          "not at the depth cut-off) may make the frame trusted; narrower ones (a person's legs, an arm) have no yaw worth the name");
+    v.num(pair_tolerance, "pair_tolerance_deg", Unit::kDegree, 0.1, 45,
+          "such two planes agree within this (their headings modulo 180 deg; coplanar ones also the line between them)");
+    v.num(pair_min_separation, "pair_min_separation_cm", Unit::kCentimetre, 0, 1000,
+          "such two planes are distinct (a flight's risers, a wall and a riser) when this far apart along their normal; "
+          "nearer, only as strips of one plane on one line (within pair_tolerance), as wide as they span together");
     v.num(carry_seconds, "carry_s", Unit::kSecond, 0, 600,
           "seconds a Manhattan frame seen in one view is carried by the odometry to later views whose own walls make "
           "none (walls do not turn when the user does); 0: never");

@@ -3,16 +3,20 @@
 /// Floor-to-Manhattan transform (paper 3.2.2). j_M is the floor's up direction; i_M and k_M are
 /// the two orthogonal horizontal directions that the vertical planes' normals agree with most
 /// (vote modulo 90 degrees weighted by area * (width / yaw_full_width)^2, the precision of a plane's
-/// yaw, refined by a circular mean of the votes near the peak; no frame when no agreeing plane is
-/// min_plane_width wide and the agreeing votes spread more than max_spread or hold no two
-/// parallel planes, e.g. only people and posts in view).
+/// yaw, refined by a circular mean of the votes near the peak). No frame unless an agreeing plane
+/// is min_plane_width wide, or two agreeing parallel planes each pair_min_width wide (not at the
+/// depth cut-off) and within pair_tolerance of each other are strips of one plane on one line
+/// spanning that width, or distinct planes pair_min_separation apart (one of them half
+/// min_plane_width wide) with the agreeing votes spread within max_spread: only people and posts
+/// in view make none.
 /// Planes with floor beyond them (furniture, risers, people: they stand inside the room) vote only
 /// when the others (walls, which bound the floor) make no frame; a wall standing on the floor is
 /// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame.
 /// A wall (no surface at all beyond it, standing on the floor or reaching the cut-off, at least
-/// veto_min_width wide) seen beyond a plane that makes the frame and disagreeing with the frame
-/// modulo 90 degrees vetoes it: no frame (`why` says so) rather than the frame of furniture turned
-/// against the room; a sliver at the cut-off disagrees only beyond clipped_disagreement.
+/// veto_min_width wide) seen beyond a plane that makes the frame (structure_beyond_area of it, or
+/// half of a smaller one) and disagreeing with the frame modulo 90 degrees vetoes it: no frame
+/// (`why` says so) rather than the frame of furniture turned against the room; a sliver at the
+/// cut-off disagrees only beyond clipped_disagreement.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -83,6 +87,7 @@ class ManhattanTracker {
     // beyond it by more than floor_beyond_margin when nx * x + nz * z < limit.
     bool has_side = false;
     float nx = 0.f, nz = 0.f, limit = 0.f;
+    float cx = 0.f, cz = 0.f;  // its centroid in the floor frame (set with has_side)
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
@@ -93,12 +98,14 @@ class ManhattanTracker {
   };
   /// Angle modulo 90 degrees by which a plane must differ from another direction to contradict it.
   float disagree_tolerance(const Vote& v) const;
+  /// Width from which an agreeing plane makes the frame trusted on its own.
+  float min_width(const Vote& v, bool bounding_only) const;
   ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, bool bounding_only);
 
   ManhattanConfig cfg_;
   float max_range_ = 0.f;
   std::optional<float> prev_yaw_;
-  std::vector<float> headings_;  // scratch: agreeing planes' headings
+  std::vector<const Vote*> pair_candidates_;  // scratch: agreeing planes wide enough to make a pair
   std::vector<Vote> votes_;               // scratch
   std::vector<FloorSample> floor_pts_;    // scratch
   std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
