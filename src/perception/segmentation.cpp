@@ -480,6 +480,204 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
   }
 }
 
+namespace {
+/// line_pass: a pixel's neighbours in the rows above and below reach this many columns either
+/// way (as far as a seed window is long, at the default strip_length_px). A far tread seen as a
+/// line one pixel row tall has runs that meet the next row's only at their ends or across a gap
+/// (the end pixels of each run are lost to the sensor's jump and shadow holes): gaps of 2-3
+/// columns between runs of 7 at 3 m, of 6-7 between runs of 20 in a view rolled by some degrees.
+constexpr int kLineReach = 8;
+}  // namespace
+
+bool Segmentation::grow_line(int region, const std::vector<int>& seed_pixels, Grow& g) {
+  // grow_region's tests (plane within the noise, local continuity against the plane's slope) and
+  // its refits on doubling, over the wider neighbourhood; the normal stays fixed to g.dir.
+  int head = 0, tail = 0;
+  for (int p : seed_pixels) {
+    label_[p] = region;
+    queue_[tail++] = p;
+    const int v = row_of(p), u = p - v * W_;
+    g.m.add(un_[u], vn_[v], w_[p]);
+  }
+  g.count = tail;
+  const Eigen::Vector3f n = dirs_[g.dir];
+  PlaneFit f = fit_plane_fixed_normal(g.m, n);
+  if (f.ok) g.plane = f;
+  int fit_count = g.count;
+  float a = g.plane.a, b = g.plane.b, c = g.plane.c;
+  const float kc = cfg_.inlier_sigmas * cfg_.depth_noise_coeff;
+  const float kl = 1.41421356f * kc;
+  InvDepthMoments m = g.m;
+  int count = g.count;
+  while (head < tail) {
+    const int p = queue_[head++];
+    const int v = row_of(p), u = p - v * W_;
+    const float wp = w_[p];
+    const float up = un_[u], vp = vn_[v];
+    auto visit = [&](int q, float uq, float vq) {
+      if (label_[q] != -1) return;
+      const float wq = w_[q];
+      if (wq <= 0.f) return;
+      const float res = wq - (a * uq + b * vq + c);
+      if (std::fabs(res) > kc) return;
+      const float step = (wq - wp) - (a * (uq - up) + b * (vq - vp));
+      if (std::fabs(step) > kl) return;
+      label_[q] = region;
+      queue_[tail++] = q;
+      m.add(uq, vq, wq);
+      if (++count >= 2 * fit_count) {
+        const PlaneFit nf = fit_plane_fixed_normal(m, n);
+        if (nf.ok) {
+          g.plane = nf;
+          a = nf.a, b = nf.b, c = nf.c;
+        }
+        fit_count = count;
+      }
+    };
+    if (u > 0) visit(p - 1, un_[u - 1], vp);
+    if (u + 1 < W_) visit(p + 1, un_[u + 1], vp);
+    const int ua = std::max(0, u - kLineReach), ub = std::min(W_ - 1, u + kLineReach);
+    if (v > 0)
+      for (int uq = ua; uq <= ub; ++uq) visit(p - W_ + (uq - u), un_[uq], vn_[v - 1]);
+    if (v + 1 < H_)
+      for (int uq = ua; uq <= ub; ++uq) visit(p + W_ + (uq - u), un_[uq], vn_[v + 1]);
+  }
+  g.m = m;
+  g.count = count;
+  const int dir = g.dir;
+  const PlaneFit nf = region_plane(g.m, g.dir);
+  if (nf.ok) g.plane = nf;
+  // A far tread's line lies between two occlusion edges: below it in the image the nosing of the
+  // tread before (nearer), above it its own nosing and the drop to the next tread (farther); both
+  // are depth jumps or shadows. A line that continues without a jump into the pixels above or
+  // below it is the edge of a surface seen at a crease (a shelf board's or a worktop's front
+  // face, a rim a few centimetres below a top), which a plane through its middle explains within
+  // the noise: not a level of its own. Counted over the line's pixels whose pixel above or below
+  // is not in the line: a reading there within two readings' noise of it is a continuation.
+  int sides = 0, smooth = 0;
+  if (g.count >= cfg_.region_min_pixels && g.dir >= 0)
+    for (int i = 0; i < tail; ++i) {
+      const int p = queue_[i];
+      const int v = row_of(p);
+      const float wp = w_[p];
+      for (int q : {p - W_, p + W_}) {
+        if ((q < p && v == 0) || (q > p && v + 1 >= H_) || label_[q] == region) continue;
+        ++sides;
+        smooth += w_[q] > 0.f && std::fabs(w_[q] - wp) <= kl;
+      }
+    }
+  if (g.count < cfg_.region_min_pixels || g.dir < 0 || 4 * smooth > sides) {
+    for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
+    released_ = tail;
+    g.count = 0;
+    g.m = {};
+    ++stats_.regions_dropped;
+    return dir >= 0 && g.dir < 0;
+  }
+  return false;
+}
+
+void Segmentation::line_pass(std::vector<Grow>& grows) {
+  // What the strip windows miss: a tread of a descending flight at 3-5 m, seen from above over
+  // the nosing before it, is a line one pixel row tall per column (its visible depth is a few
+  // centimetres). Where the flight runs at an angle across the image, each row holds a run of a
+  // few pixels that overlaps the next row's by a pixel or two, or not at all: no 2-row window
+  // holds enough of it. A run of free pixels in one row fixes a plane's offset on a dominant
+  // direction (one unknown, as the strip windows), and its growth reaches across the gaps
+  // between rows. Only dominant directions: a line cannot fix a tilt.
+  const int len = cfg_.strip_length_px;
+  if (len < 2 || dirs_.empty()) return;
+  const int need = std::max(3, (3 * len) / 4);
+  const int cs = std::max(2, cfg_.cell_size_px);
+  const float limit = 0.5f * tolerance_w();
+  const float kl = 1.41421356f * cfg_.inlier_sigmas * cfg_.depth_noise_coeff;  // two readings' noise
+  std::vector<LineSeed>& seeds = line_seeds_;
+  seeds.clear();
+  auto free_px = [&](int p) { return label_[p] == -1 && z_[p] > 0.f && tried_[p] == 0; };
+  for (int v = 0; v < H_; ++v) {
+    const int row = v * W_;
+    const int cv = vcell_[v];
+    for (int u = 0; u < W_;) {
+      // A coarse cell that joined a region has no free pixel left.
+      const int cu = ucell_[u];
+      if (u == cu * cs && cv < CH_ && cu < CW_ && cell_label_[static_cast<std::size_t>(cv * CW_ + cu)] >= 0) {
+        u += cs;
+        continue;
+      }
+#if defined(__SSE2__)
+      if (u + 4 <= W_ && v > 0 && v + 1 < H_) {
+        // Most pixels here are taken (fine seeds, strips, edge pixels of the cell pass), holes, or
+        // free pixels of clutter continuing into the rows above and below: four at a time while
+        // none is free with a hole or a depth jump both above and below (see the windows below).
+        const __m128 zero = _mm_setzero_ps();
+        const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)), kl4 = _mm_set1_ps(kl);
+        const __m128i lab = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&label_[row + u]));
+        const __m128 w = _mm_loadu_ps(&w_[row + u]);
+        const __m128 wu = _mm_loadu_ps(&w_[row + u - W_]), wd = _mm_loadu_ps(&w_[row + u + W_]);
+        const __m128 up = _mm_and_ps(_mm_cmpgt_ps(wu, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wu, w), absmask), kl4));
+        const __m128 down = _mm_and_ps(_mm_cmpgt_ps(wd, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wd, w), absmask), kl4));
+        const __m128 fr = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(lab, _mm_set1_epi32(-1))), _mm_cmpgt_ps(w, zero));
+        if (_mm_movemask_ps(_mm_andnot_ps(_mm_or_ps(up, down), fr)) == 0) {
+          u += 4;
+          continue;
+        }
+      }
+#endif
+      if (!free_px(row + u)) {
+        ++u;
+        continue;
+      }
+      int e = u + 1;
+      while (e < W_ && free_px(row + e)) ++e;
+      // Windows of len columns along the run (a long run may bend), the last one if long enough.
+      for (int s = u; s + need <= e; s += len) {
+        const int n = std::min(len, e - s);
+        // A line's pixels have a hole or a depth jump both above and below, but where it meets
+        // the next row's run: a window with few such pixels is a row of a surface (clutter, the
+        // rest of a region's edge), and its growth would be released (grow_line) at a cost.
+        int enclosed = 0;
+        for (int k = s; k < s + n; ++k) {
+          const float wk = w_[row + k];
+          const bool up = v > 0 && w_[row + k - W_] > 0.f && std::fabs(w_[row + k - W_] - wk) <= kl;
+          const bool down = v + 1 < H_ && w_[row + k + W_] > 0.f && std::fabs(w_[row + k + W_] - wk) <= kl;
+          enclosed += !up && !down;
+        }
+        if (4 * enclosed < n) continue;
+        InvDepthMoments m;
+        for (int k = s; k < s + n; ++k) m.add(un_[k], vn_[v], w_[row + k]);
+        PlaneFit fc;
+        if (best_direction(m, fc) < 0) continue;
+        seeds.push_back({s, v, n, fc.rms_w / limit + fc.mean.z()});
+      }
+      u = e;
+    }
+  }
+  // Nearer and better-fitting seeds first (as the other passes).
+  std::stable_sort(seeds.begin(), seeds.end(), [](const LineSeed& x, const LineSeed& y) { return x.score < y.score; });
+  for (const LineSeed& sd : seeds) {
+    InvDepthMoments m;
+    seed_pixels_.clear();
+    const int row = sd.v * W_;
+    for (int k = sd.u0; k < sd.u0 + sd.n; ++k) {
+      if (!free_px(row + k)) continue;
+      seed_pixels_.push_back(row + k);
+      m.add(un_[k], vn_[sd.v], w_[row + k]);
+    }
+    if (static_cast<int>(seed_pixels_.size()) < need) continue;
+    Grow g;
+    g.dir = best_direction(m, g.plane);
+    if (g.dir < 0) continue;
+    ++stats_.seeds_used;
+    released_ = 0;
+    grow_line(static_cast<int>(grows.size()), seed_pixels_, g);
+    if (g.count == 0)
+      for (int i = 0; i < released_; ++i) tried_[static_cast<std::size_t>(queue_[i])] = 1;
+    else
+      ++stats_.line_regions;
+    grows.push_back(g);
+  }
+}
+
 static double InvDepthMomentsMsr(const InvDepthMoments& m, double a, double b, double c) {
   // Mean squared residual of the points under 1/z = a u' + b v' + c, from the moments.
   if (m.n <= 0) return 0.0;
@@ -1929,6 +2127,7 @@ bool Segmentation::run(const RgbdFrame& frame, std::vector<PlaneRegion>& regions
     seed_pass(cfg_.fine_cell_size_px, grows_);
   stats_.seeds_ms = lap();
   strip_pass(grows_);
+  line_pass(grows_);
   split_creases(grows_);
   split_border_bands(grows_);
   split_edge_bands(grows_);

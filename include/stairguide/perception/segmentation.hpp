@@ -18,7 +18,12 @@
 ///     `dominant_min_fraction` of the image: floor, walls, near treads and risers): a seed that
 ///     lies on a plane parallel to one, within the noise, grows with that normal fixed and only
 ///     its offset fitted; it keeps the fixed normal only while its pixels do not reject it (its
-///     free fit is not clearly better);
+///     free fit is not clearly better); last, windows of runs of free pixels in one row with a
+///     hole or a depth jump above and below (treads of a descent at 3-5 m seen as lines one row
+///     tall per column, whose rows touch only at their ends or not at all) seed on a dominant
+///     direction only and grow to the rows above and below across gaps of a few columns; a line
+///     that continues without a depth jump into the rows above or below (the front face of a
+///     shelf board under its top) is released;
 ///  4b. a strip one cell row tall whose plane is a blend of two dominant directions (a cell
 ///     across a tread/riser crease at range, planar within the noise) is split along the crease
 ///     line of the two; a band of up to a few rows at the top border of the view that lies on
@@ -123,6 +128,7 @@ struct SegmentationStats {
   int crease_splits = 0;  ///< regions split along a crease between two dominant directions
   int border_splits = 0;  ///< bands at the top border split off their region
   int edge_splits = 0;    ///< bands below an occlusion edge split off their region
+  int line_regions = 0;   ///< regions grown from one-row line seeds (line_pass)
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -161,6 +167,13 @@ class Segmentation {
   /// Plane of a region's moments: fixed to its dominant direction while the pixels accept it.
   PlaneFit region_plane(const InvDepthMoments& m, int& dir) const;
   void strip_pass(std::vector<Grow>& grows);
+  /// Seeds from runs of free pixels in one row on a dominant direction, grown across small gaps
+  /// between rows (far treads of a descent seen as lines one pixel row tall).
+  void line_pass(std::vector<Grow>& grows);
+  /// grow_region for line_pass: the neighbours of a pixel are its left and right ones and those
+  /// up to kLineReach columns away in the rows above and below (g.dir fixed). The same return;
+  /// also released when it continues without a depth jump into the rows above or below it.
+  bool grow_line(int region, const std::vector<int>& seed_pixels, Grow& g);
   /// Splits regions that straddle a crease between two dominant directions (a tread and its
   /// riser within one cell row, at range) along the crease line.
   void split_creases(std::vector<Grow>& grows);
@@ -214,6 +227,11 @@ class Segmentation {
     float score;
   };
   std::vector<Cell> cells_, cells_tmp_;
+  struct LineSeed {
+    int u0, v, n;
+    float score;
+  };
+  std::vector<LineSeed> line_seeds_;  // line_pass: runs of free pixels in one row
   std::vector<std::uint64_t> sort_keys_;  // sort_cells: (score bits, index) keys
   /// Sorts cells_ by ascending score, in the very order std::sort on the cells gives (ties too).
   void sort_cells();

@@ -1,0 +1,78 @@
+// Far treads of a descending flight seen as lines one pixel row tall (issue #3: every tread with
+// at least 200 visible pixels found as its own horizontal region). Views from held-out seeds
+// where the flight runs at an angle across the image: each row holds a run of 5-8 pixels of the
+// tread, touching the next row's only at its end or not at all (segmentation's line_pass).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/perception.hpp"
+
+using namespace stairguide;
+
+namespace {
+
+constexpr float kDeg = 3.14159265f / 180.f;
+
+struct Case {
+  const char* preset;
+  long index;
+  std::uint32_t seed;
+  int tread;  // 1-based index of the far tread to find
+};
+
+// The region of `sc` that is tread k of the (descending) staircase: horizontal, centroid at the
+// tread's height and inside the flight. -1 when none.
+int find_tread(const SceneResult& sc, const StairTruth& st, int k, const Eigen::Vector3f& up) {
+  const Pose T_sc = st.T_camera_stair.inverse();
+  int best = -1;
+  for (int r = 0; r < static_cast<int>(sc.regions.size()); ++r) {
+    const PlaneRegion& R = sc.regions[r];
+    if (std::fabs(R.normal.dot(up)) < std::cos(10 * kDeg)) continue;
+    const Eigen::Vector3f c = T_sc * R.centroid;
+    if (std::fabs(c.y() + k * st.riser_m) > 0.05f || std::fabs(c.x()) > 0.5f * st.width_m + 0.1f) continue;
+    if (best < 0 || R.pixel_count > sc.regions[best].pixel_count) best = r;
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST(PerceptionTreads, FarDescendingTreadsSeenAsLinesAreRegions) {
+  // Tread 8 at 4.5 m (rows overlap by a pixel or two) and tread 3 at 3.2 m (rows 2-3 columns apart).
+  const Case cases[] = {{"descending_static", 5, 1, 8}, {"descending_static", 6, 7, 3}};
+  Perception P;
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult sc;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed));
+    synth::render_preset_frame(c.preset, c.index, c.seed, synth::SynthOptions{}, frame, truth);
+    ASSERT_FALSE(truth.stairs.empty());
+    const StairTruth& st = truth.stairs[0];
+    ASSERT_EQ(st.kind, StairKind::kDescending);
+    bool visible = false;
+    for (std::size_t i = 0; i < st.visible_steps.size(); ++i)
+      visible |= st.visible_steps[i] == c.tread && st.visible_pixels[i] >= 200;
+    ASSERT_TRUE(visible) << "the view no longer shows tread " << c.tread << " (synthetic world changed?)";
+    P.reset();
+    P.process(frame, sc);
+    ASSERT_TRUE(sc.floor_found);
+    const Eigen::Vector3f up = truth.T_world_camera.linear().row(2).transpose();
+    const int r = find_tread(sc, st, c.tread, up);
+    ASSERT_GE(r, 0) << "tread " << c.tread << " not found";
+    const PlaneRegion& R = sc.regions[r];
+    EXPECT_LE(std::acos(std::min(1.f, std::fabs(R.normal.dot(up)))) / kDeg, 2.f);
+    // Height above the user's floor (the stair origin is on it, at the first drop).
+    EXPECT_NEAR(R.height, -c.tread * st.riser_m, 0.01f);
+    EXPECT_EQ(R.cls, RegionClass::kStepCandidate);
+    // One level only: every point within the noise of the tread's height.
+    const Pose T_sc = st.T_camera_stair.inverse();
+    int off = 0;
+    for (const Eigen::Vector3f& q : R.points)
+      off += std::fabs((T_sc * q).y() + c.tread * st.riser_m) > 0.03f + 3 * 1.425e-3f * q.z() * q.z();
+    EXPECT_LE(off, static_cast<int>(0.03 * R.points.size()));
+  }
+}
