@@ -1019,11 +1019,17 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
   tops.clear();
   std::vector<float>& acc = edge_acc_;  // per candidate and bin: count, sum and sum of squares of residuals
   acc.assign(regs.size() * static_cast<std::size_t>(3 * K), 0.f);
+  // The edge over a tread's sliver runs along the image rows (give or take the staircase's yaw
+  // and the camera's roll): its tops come in runs along a row. A top with no top of its region
+  // beside it is on a side edge of the region (a riser's end, stepped holes down a slanted
+  // border), whose pixels lie on the region's own plane and would spoil the band's fit.
+  auto is_top = [&](int q, int l) { return label_[q] == l && !(z_[q - W_] > 0.f) && !(z_[q - 2 * W_] > 0.f); };
   auto edge_top = [&](int p) {
     const int l = label_[p];
     if (l < 0 || slot[l] < 0) return;
-    tops.push_back(p);
     const int v = row_of(p), u = p - v * W_;
+    if (!((u > 0 && is_top(p - 1, l)) || (u + 1 < W_ && is_top(p + 1, l)))) return;
+    tops.push_back(p);
     const PlaneFit& f = grows[l].plane;
     float* a = &acc[static_cast<std::size_t>(slot[l]) * 3 * K];
     for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) {
