@@ -5,6 +5,8 @@
 // Also far treads of an ascending flight seen as a sliver of one or two rows between the top of
 // their riser and the shadow above (segmentation's split_edge_bands), where the riser's region
 // ends beside the sliver in a stepped, slanted side edge.
+// And ascending treads leaving the view at its top border at a slant: a wedge of a few rows over
+// their riser, which reaches the border beside it (segmentation's split_slanted_border_band).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -99,5 +101,14 @@ TEST(PerceptionTreads, AscendingTreadSliversUnderTheShadowAreRegions) {
   // Tread 5 at 3.4 m (a row or two of it over its riser, ~120 px) and tread 3 of a rotated flight
   // at 3.0 m (the shadow's edge slants across the rows): before, their risers' regions took them.
   const Case cases[] = {{"ascending_static", 1, 9, 5}, {"rotated_static", 16, 10, 3}};
+  expect_treads_found(cases, 2, StairKind::kAscending);
+}
+
+TEST(PerceptionTreads, AscendingTreadSliversAtTheTopBorderLeavingAtASlantAreRegions) {
+  // Tread 4 at 2.4 m (a wedge of one to three rows at the top of the view, ~150 px, the riser
+  // below reaching the border beside it) and tread 5 of a rotated flight at 2.1 m: a band of
+  // whole rows held two to three times as many riser pixels as tread ones, and the riser's
+  // region kept the sliver (segmentation's split_slanted_border_band).
+  const Case cases[] = {{"handrails_open_sides_static", 11, 10, 4}, {"rotated_static", 17, 11, 5}};
   expect_treads_found(cases, 2, StairKind::kAscending);
 }

@@ -909,8 +909,11 @@ void Segmentation::split_border_bands(std::vector<Grow>& grows) {
   }
   for (std::size_t i = 0; i < regs.size(); ++i) {
     const int r = regs[i];
-    const BandSplit best = best_band_split(grows[r], &bins_[i * K], /*below_edge=*/false);
-    if (best.dir < 0) continue;
+    const BandSplit best = best_band_split(grows[r], &bins_[i * K], K, /*below_edge=*/false);
+    if (best.dir < 0) {
+      if (split_slanted_border_band(grows, r)) ++stats_.border_splits;
+      continue;
+    }
     std::vector<int>& pix = split_pixels_;
     pix.clear();
     for (int v = 0; v < best.rows; ++v)
@@ -922,12 +925,12 @@ void Segmentation::split_border_bands(std::vector<Grow>& grows) {
   }
 }
 
-Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDepthMoments* bins,
-                                                      bool below_edge) const {
+Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDepthMoments* bins, int nb,
+                                                      bool below_edge, int only_dir) const {
   // The band is the region's first k rows from the border or the edge (bins[0..k)), for each k up
-  // to kBorderBandRows; it is split off onto a dominant direction when that explains the region
-  // better than its one plane by kSplitGain noise sigmas.
-  const int K = kBorderBandRows;
+  // to nb; it is split off onto a dominant direction when that explains the region better than
+  // its one plane by kSplitGain noise sigmas.
+  const int K = nb;
   // The direction a tread sliver may take against its riser's plane: square to it within 15
   // degrees below an edge (the edges found there are many, keep to treads); at the border any
   // crease of 60 degrees or more (oblique directions of clutter do not count).
@@ -949,7 +952,7 @@ Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDe
     // What stays must be a plane (below an edge, one within the noise).
     const PlaneFit fr = fit_plane(rest);
     if (!fr.ok || (below_edge && fr.rms_w > limit)) continue;
-    for (int d = 0; d < nd; ++d) {
+    for (int d = only_dir < 0 ? 0 : only_dir; d < (only_dir < 0 ? nd : only_dir + 1); ++d) {
       if (std::fabs(dirs_[d].dot(g.plane.normal)) > max_cos) continue;
       // The sliver lies on that direction within the noise (a bent surface, a person, does not).
       const PlaneFit fb = fit_plane_fixed_normal(band, dirs_[d]);
@@ -962,8 +965,100 @@ Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDe
       if (ssr < best) best = ssr, out.rows = k, out.dir = d;
     }
   }
-  if (out.dir >= 0 && ssr_joint - best < kSplitGain * sig2) out = BandSplit{};
+  out.gain = ssr_joint - best;
+  if (out.dir >= 0 && out.gain < kSplitGain * sig2) out = BandSplit{};
   return out;
+}
+
+bool Segmentation::split_slanted_border_band(std::vector<Grow>& grows, int r) {
+  // A tread leaving the view at a slant (the staircase's yaw, the camera's roll): its sliver is a
+  // wedge at the top border, a few rows deep at one end and none further along, where the riser
+  // below reaches the border. A band of whole rows then holds riser pixels across the region's
+  // width (several times the sliver's), and its fit on the tread's direction fails. The band here
+  // is bounded by a line parallel to the crease the two planes make in the image, swept down from
+  // the border; the same tests as for a band of rows decide.
+  const Grow& g = grows[r];
+  // The band must hold 1.5 times the smallest region and an eighth of its region at most (below).
+  if (!g.plane.ok || g.count < 12 * cfg_.region_min_pixels) return false;
+  const int K = 3 * kBorderBandRows;  // deepest wedge point tried, in pixels across the line
+  const int R = std::min(H_, K);      // rows read
+  std::vector<int>& pix = split_pixels_;
+  pix.clear();
+  double su0 = 0;
+  int n0 = 0;
+  for (int v = 0; v < R; ++v) {
+    const int* lab = &label_[static_cast<std::size_t>(v) * W_];
+    for (int u = 0; u < W_; ++u)
+      if (lab[u] == r) {
+        pix.push_back(v * W_ + u);
+        if (v == 0) su0 += u, ++n0;
+      }
+  }
+  if (n0 == 0 || static_cast<int>(pix.size()) < cfg_.region_min_pixels) return false;
+  // The crease's image direction is taken where the region meets the border: the point of the
+  // region's plane under its border pixels' mean column.
+  const float un = (static_cast<float>(su0 / n0) - K_.cx) / K_.fx, vn = (0.f - K_.cy) / K_.fy;
+  const float w = g.plane.a * un + g.plane.b * vn + g.plane.c;
+  if (!(w > 1e-6f)) return false;
+  const Eigen::Vector3f P(un / w, vn / w, 1.f / w);
+  const float max_cos = std::cos(60.f * 3.14159265f / 180.f);
+  const int nd = static_cast<int>(dirs_.size());
+  BandSplit best;
+  float best_eu = 0, best_ev = 0, best_smin = 0;
+  for (int d = 0; d < nd; ++d) {
+    if (std::fabs(dirs_[d].dot(g.plane.normal)) > max_cos) continue;
+    const Eigen::Vector3f t3 = g.plane.normal.cross(dirs_[d]);
+    if (!(t3.norm() > 1e-3f)) continue;
+    const Eigen::Vector3f t = t3.normalized();
+    float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
+    const float ln = std::sqrt(du * du + dv * dv);
+    if (!(ln > 1e-9f)) continue;
+    du /= ln, dv /= ln;
+    // Slanted, but along the rows within 30 degrees (a level band is the row pass's); steeper is
+    // a wall's corner, not a tread's crease.
+    if (std::fabs(dv) > 0.5f || std::fabs(dv) < 0.01f) continue;
+    float eu = -dv, ev = du;  // across the line, pointing down the image
+    if (ev < 0.f) eu = -eu, ev = -ev;
+    float smin = 1e30f;
+    for (int p : pix) {
+      const int v = row_of(p), u = p - v * W_;
+      smin = std::min(smin, eu * u + ev * v);
+    }
+    slant_bins_.assign(static_cast<std::size_t>(K), InvDepthMoments{});
+    for (int p : pix) {
+      const int v = row_of(p), u = p - v * W_;
+      const int k = static_cast<int>(eu * u + ev * v - smin);
+      if (k < K) slant_bins_[static_cast<std::size_t>(k)].add(un_[u], vn_[v], w_[p]);
+    }
+    const BandSplit b = best_band_split(g, slant_bins_.data(), K, /*below_edge=*/false, d);
+    if (b.dir >= 0 && b.gain > best.gain) best = b, best_eu = eu, best_ev = ev, best_smin = smin;
+  }
+  if (best.dir < 0) return false;
+  std::vector<int>& band = split_side_;
+  band.clear();
+  for (int p : pix) {
+    const int v = row_of(p), u = p - v * W_;
+    if (static_cast<int>(best_eu * u + best_ev * v - best_smin) < best.rows) band.push_back(p);
+  }
+  // The slanted band has more freedom than a band of rows (a direction and an offset per pixel
+  // row), so it must also look like a tread's sliver over its riser: a wedge (the region holds
+  // border pixels beyond it: else a band of rows would do), behind the region's plane (the convex
+  // edge of a nosing seen from above it), sizeable on its own, and a small part of a region whose
+  // plane it was all but lost in (clutter's small regions split on any slant otherwise).
+  const int nb = static_cast<int>(band.size());
+  InvDepthMoments bm;
+  int b0 = 0;
+  for (int p : band) {
+    const int v = row_of(p), u = p - v * W_;
+    bm.add(un_[u], vn_[v], w_[p]);
+    b0 += v == 0;
+  }
+  if (b0 >= n0 || 2 * nb < 3 * cfg_.region_min_pixels || grows[r].count < 8 * nb ||
+      !(bm.mean_residual(grows[r].plane.a, grows[r].plane.b, grows[r].plane.c) < 0.0))
+    return false;
+  if (!move_to_new_region(grows, r, band, best.dir)) return false;
+  refit_region(grows[r]);
+  return true;
 }
 
 void Segmentation::refit_region(Grow& g) const {
@@ -1100,7 +1195,7 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
   for (std::size_t i = 0; i < regs.size(); ++i) {
     const int r = regs[i];
     if (slot[r] < 0) continue;
-    const BandSplit best = best_band_split(grows[r], &bins_[i * K], /*below_edge=*/true);
+    const BandSplit best = best_band_split(grows[r], &bins_[i * K], K, /*below_edge=*/true);
     if (best.dir < 0) continue;
     std::vector<int>& pix = split_pixels_;
     pix.clear();

@@ -185,10 +185,19 @@ class Segmentation {
   void split_edge_bands(std::vector<Grow>& grows);
   /// The band of a region's first rows (from the top border or below an occlusion edge) to split
   /// off onto a dominant direction: rows 0 and dir -1 when none explains the region better.
+  /// `bins` holds the moments of the region's pixels per row (or per sweep step) from the border,
+  /// `nb` of them; `only_dir` >= 0 tries that direction alone. `gain` is the drop in the summed
+  /// squared residual (1/m^2) the split brings.
   struct BandSplit {
     int rows = 0, dir = -1;
+    double gain = 0.0;
   };
-  BandSplit best_band_split(const Grow& g, const InvDepthMoments* bins, bool below_edge) const;
+  BandSplit best_band_split(const Grow& g, const InvDepthMoments* bins, int nb, bool below_edge,
+                            int only_dir = -1) const;
+  /// For a region touching the top border that no band of rows splits: the band bounded by a line
+  /// parallel to the crease between its plane and another dominant direction (a tread sliver
+  /// leaving the view at a slant). Moves the band to a new region; returns whether it did.
+  bool split_slanted_border_band(std::vector<Grow>& grows, int r);
   /// Refits a region's plane after pixels left it (fixed to its dominant direction while they accept it).
   void refit_region(Grow& g) const;
   /// Moves the pixels of region `r` listed in `pixels` to a new region on direction `dir`.
@@ -264,6 +273,7 @@ class Segmentation {
   std::vector<float> edge_acc_;  // split_edge_bands: residual sums per candidate region and band row
   std::vector<Eigen::Vector3f> big_dirs_;  // region pairs: seam samples, depth-continuous ones
   std::vector<InvDepthMoments> bins_;  // split passes: moments per sweep bin / row
+  std::vector<InvDepthMoments> slant_bins_;  // split_slanted_border_band: moments per sweep step
   std::vector<int> split_pixels_, split_side_;
   struct SplitCand {
     int r, np, pairs[4][2];
