@@ -260,7 +260,17 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   stats_.valid_pixels = valid;
 }
 
-bool Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, Grow& g) {
+namespace {
+/// line_pass: a pixel's neighbours in the rows above and below reach this many columns either
+/// way (as far as a seed window is long, at the default strip_length_px). A far tread seen as a
+/// line one pixel row tall has runs that meet the next row's only at their ends or across a gap
+/// (the end pixels of each run are lost to the sensor's jump and shadow holes): gaps of 2-3
+/// columns between runs of 7 at 3 m, of 6-7 between runs of 20 in a view rolled by some degrees.
+constexpr int kLineReach = 8;
+}  // namespace
+
+template <int kReach>
+int Segmentation::grow_pixels(int region, const std::vector<int>& seed_pixels, Grow& g) {
   int head = 0, tail = 0;
   for (int p : seed_pixels) {
     label_[p] = region;
@@ -313,24 +323,39 @@ bool Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, 
     };
     if (u > 0) visit(p - 1, un_[u - 1], vp);
     if (u + 1 < W_) visit(p + 1, un_[u + 1], vp);
-    if (v > 0) visit(p - W_, up, vn_[v - 1]);
-    if (v + 1 < H_) visit(p + W_, up, vn_[v + 1]);
+    if constexpr (kReach == 0) {
+      if (v > 0) visit(p - W_, up, vn_[v - 1]);
+      if (v + 1 < H_) visit(p + W_, up, vn_[v + 1]);
+    } else {
+      const int ua = std::max(0, u - kReach), ub = std::min(W_ - 1, u + kReach);
+      if (v > 0)
+        for (int uq = ua; uq <= ub; ++uq) visit(p - W_ + (uq - u), un_[uq], vn_[v - 1]);
+      if (v + 1 < H_)
+        for (int uq = ua; uq <= ub; ++uq) visit(p + W_ + (uq - u), un_[uq], vn_[v + 1]);
+    }
   }
   g.m = m;
   g.count = count;
-  const int dir = g.dir;
   const PlaneFit nf = region_plane(g.m, g.dir);
   if (nf.ok) g.plane = nf;
-  if (g.count < cfg_.region_min_pixels || (dir >= 0 && g.dir < 0)) {
-    // Too small to be a region, or grown on a dominant direction its pixels reject: give its
-    // pixels back for later seeds and for clustering.
-    for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
-    released_ = tail;
-    g.count = 0;
-    g.m = {};
-    ++stats_.regions_dropped;
-    return dir >= 0 && g.dir < 0;
-  }
+  return tail;
+}
+
+bool Segmentation::release_growth(int tail, Grow& g, int dir) {
+  // Too small to be a region, or grown on a dominant direction its pixels reject: give its
+  // pixels back for later seeds and for clustering.
+  for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
+  released_ = tail;
+  g.count = 0;
+  g.m = {};
+  ++stats_.regions_dropped;
+  return dir >= 0 && g.dir < 0;
+}
+
+bool Segmentation::grow_region(int region, const std::vector<int>& seed_pixels, Grow& g) {
+  const int dir = g.dir;
+  const int tail = grow_pixels<0>(region, seed_pixels, g);
+  if (g.count < cfg_.region_min_pixels || (dir >= 0 && g.dir < 0)) return release_growth(tail, g, dir);
   return false;
 }
 
@@ -480,73 +505,13 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
   }
 }
 
-namespace {
-/// line_pass: a pixel's neighbours in the rows above and below reach this many columns either
-/// way (as far as a seed window is long, at the default strip_length_px). A far tread seen as a
-/// line one pixel row tall has runs that meet the next row's only at their ends or across a gap
-/// (the end pixels of each run are lost to the sensor's jump and shadow holes): gaps of 2-3
-/// columns between runs of 7 at 3 m, of 6-7 between runs of 20 in a view rolled by some degrees.
-constexpr int kLineReach = 8;
-}  // namespace
 
 bool Segmentation::grow_line(int region, const std::vector<int>& seed_pixels, Grow& g) {
   // grow_region's tests (plane within the noise, local continuity against the plane's slope) and
   // its refits on doubling, over the wider neighbourhood; the normal stays fixed to g.dir.
-  int head = 0, tail = 0;
-  for (int p : seed_pixels) {
-    label_[p] = region;
-    queue_[tail++] = p;
-    const int v = row_of(p), u = p - v * W_;
-    g.m.add(un_[u], vn_[v], w_[p]);
-  }
-  g.count = tail;
-  const Eigen::Vector3f n = dirs_[g.dir];
-  PlaneFit f = fit_plane_fixed_normal(g.m, n);
-  if (f.ok) g.plane = f;
-  int fit_count = g.count;
-  float a = g.plane.a, b = g.plane.b, c = g.plane.c;
-  const float kc = cfg_.inlier_sigmas * cfg_.depth_noise_coeff;
-  const float kl = 1.41421356f * kc;
-  InvDepthMoments m = g.m;
-  int count = g.count;
-  while (head < tail) {
-    const int p = queue_[head++];
-    const int v = row_of(p), u = p - v * W_;
-    const float wp = w_[p];
-    const float up = un_[u], vp = vn_[v];
-    auto visit = [&](int q, float uq, float vq) {
-      if (label_[q] != -1) return;
-      const float wq = w_[q];
-      if (wq <= 0.f) return;
-      const float res = wq - (a * uq + b * vq + c);
-      if (std::fabs(res) > kc) return;
-      const float step = (wq - wp) - (a * (uq - up) + b * (vq - vp));
-      if (std::fabs(step) > kl) return;
-      label_[q] = region;
-      queue_[tail++] = q;
-      m.add(uq, vq, wq);
-      if (++count >= 2 * fit_count) {
-        const PlaneFit nf = fit_plane_fixed_normal(m, n);
-        if (nf.ok) {
-          g.plane = nf;
-          a = nf.a, b = nf.b, c = nf.c;
-        }
-        fit_count = count;
-      }
-    };
-    if (u > 0) visit(p - 1, un_[u - 1], vp);
-    if (u + 1 < W_) visit(p + 1, un_[u + 1], vp);
-    const int ua = std::max(0, u - kLineReach), ub = std::min(W_ - 1, u + kLineReach);
-    if (v > 0)
-      for (int uq = ua; uq <= ub; ++uq) visit(p - W_ + (uq - u), un_[uq], vn_[v - 1]);
-    if (v + 1 < H_)
-      for (int uq = ua; uq <= ub; ++uq) visit(p + W_ + (uq - u), un_[uq], vn_[v + 1]);
-  }
-  g.m = m;
-  g.count = count;
   const int dir = g.dir;
-  const PlaneFit nf = region_plane(g.m, g.dir);
-  if (nf.ok) g.plane = nf;
+  const int tail = grow_pixels<kLineReach>(region, seed_pixels, g);
+  const float kl = 1.41421356f * cfg_.inlier_sigmas * cfg_.depth_noise_coeff;  // two readings' noise
   // A far tread's line lies between two occlusion edges: below it in the image the nosing of the
   // tread before (nearer), above it its own nosing and the drop to the next tread (farther); both
   // are depth jumps or shadows. A line that continues without a jump into the pixels above or
@@ -566,14 +531,7 @@ bool Segmentation::grow_line(int region, const std::vector<int>& seed_pixels, Gr
         smooth += w_[q] > 0.f && std::fabs(w_[q] - wp) <= kl;
       }
     }
-  if (g.count < cfg_.region_min_pixels || g.dir < 0 || 4 * smooth > sides) {
-    for (int i = 0; i < tail; ++i) label_[queue_[i]] = -1;
-    released_ = tail;
-    g.count = 0;
-    g.m = {};
-    ++stats_.regions_dropped;
-    return dir >= 0 && g.dir < 0;
-  }
+  if (g.count < cfg_.region_min_pixels || g.dir < 0 || 4 * smooth > sides) return release_growth(tail, g, dir);
   return false;
 }
 

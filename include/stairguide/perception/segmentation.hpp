@@ -161,6 +161,15 @@ class Segmentation {
   /// Grows a region from `seed_pixels` (g.plane, g.dir set). Returns true when the region was
   /// grown with a fixed normal its pixels reject (it is then released, g.count == 0).
   bool grow_region(int region, const std::vector<int>& seed_pixels, Grow& g);
+  /// The growth of grow_region and grow_line: labels the seed pixels, then takes neighbours
+  /// breadth-first (left, right, above, below; with kReach > 0 the rows above and below up to
+  /// kReach columns either way) that lie on the plane within the noise and continue their
+  /// neighbour's depth, refitting as the region doubles (g.dir >= 0: normal fixed), and refits
+  /// g's plane at the end. Returns how many pixels it labelled (queue_[0, n)).
+  template <int kReach> int grow_pixels(int region, const std::vector<int>& seed_pixels, Grow& g);
+  /// Gives a dropped growth's `tail` pixels back (released_), empties g; returns whether it was
+  /// grown on a dominant direction (`dir`) its pixels reject.
+  bool release_growth(int tail, Grow& g, int dir);
   void find_dominant_directions(const std::vector<Grow>& grows);
   /// Best fixed-normal fit of `m` over the dominant directions within the planar-cell limit (-1: none).
   int best_direction(const InvDepthMoments& m, PlaneFit& fit) const;
