@@ -166,6 +166,7 @@ std::uint64_t scene_checksum(const SceneResult& s) {
   f.pod(s.clusters.size());
   for (const ObstacleCluster& c : s.clusters) f.vec(c.points), f.pod(c.centroid), f.pod(c.min), f.pod(c.max);
   f.pod(s.floor_found), f.pod(s.manhattan_found);
+  if (s.manhattan_found) f.pod(s.manhattan_yaw);  // a change to the Manhattan stage shows here too
   f.bytes(s.T_floor_camera.matrix().data(), 16 * sizeof(float));
   return f.h;
 }
