@@ -611,7 +611,12 @@ void Segmentation::line_pass(std::vector<Grow>& grows) {
     }
   }
   // Nearer and better-fitting seeds first (as the other passes).
-  std::stable_sort(seeds.begin(), seeds.end(), [](const LineSeed& x, const LineSeed& y) { return x.score < y.score; });
+  // Ties in the order they were found (row, then column), as a stable sort gives, without the
+  // buffer std::stable_sort allocates on every frame.
+  std::sort(seeds.begin(), seeds.end(), [](const LineSeed& x, const LineSeed& y) {
+    if (x.score != y.score) return x.score < y.score;
+    return x.v != y.v ? x.v < y.v : x.u0 < y.u0;
+  });
   for (const LineSeed& sd : seeds) {
     InvDepthMoments m;
     seed_pixels_.clear();
