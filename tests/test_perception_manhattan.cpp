@@ -86,3 +86,21 @@ TEST(ManhattanFrame, SmallWallBeyondFurnitureVetoesItsFrame) {
         << c.preset << " #" << c.index << " seed " << c.seed << ": frame " << v.yaw_err << " deg off";
   }
 }
+
+// A wall seen beyond furniture turned against the room, as wide as a wall that makes a frame on its
+// own (ManhattanConfig::min_plane_width), gives the frame: the furniture's frame is wrong, the
+// room's is in view (before: a sofa's or shelves' frame vetoed, and no frame at all).
+TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
+  const struct {
+    const char* preset;
+    long index;
+    std::uint32_t seed;
+  } views[] = {{"sofa_static", 23, kSuiteSeed}, {"sofa_static", 13, 1}, {"shelves_static", 13, 3}};
+  for (const auto& c : views) {
+    const View v = run_view(c.preset, c.index, c.seed);
+    ASSERT_GE(v.truth.wall_or_riser_pixels, 1000) << c.preset << " #" << c.index << " seed " << c.seed;
+    EXPECT_GE(v.yaw_err, 0.f) << c.preset << " #" << c.index << " seed " << c.seed << ": no frame ("
+                              << v.sc.manhattan_why << ")";
+    EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index << " seed " << c.seed;
+  }
+}

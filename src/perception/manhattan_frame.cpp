@@ -223,6 +223,8 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     }
     return sum;
   };
+  std::vector<const Vote*>& vetoes = vetoes_;  // the walls that veto the frame
+  vetoes.clear();
   for (const Vote& vf : votes) {
     // A wall stands on the floor or goes on past the depth cut-off; a plane floating above the
     // floor and ending within range with nothing seen behind it may be a person's upper body.
@@ -243,12 +245,40 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
       // wall 0.2 to 0.3 m wide seen past a sofa or shelves has 0.01 to 0.02 m^2 in view: synthetic
       // views 9 to 14 degrees off before).
       if (area_beyond(vn, f0, f1) < std::min(cfg_.structure_beyond_area, 0.5f * vf.area)) continue;
+      vetoes.push_back(&vf);
+      break;
+    }
+  }
+  if (!vetoes.empty()) {
+    // The widest vetoing wall, when as wide as a wall that makes a frame on its own
+    // (min_plane_width), gives the frame itself with the walls agreeing with it: the furniture in
+    // front of it is turned against the room, the room is not (synthetic sofa and shelves views
+    // that had no frame). A narrower one, or vetoing walls that disagree among themselves, only
+    // say the frame is wrong.
+    const Vote* veto = vetoes.front();
+    for (const Vote* v : vetoes)
+      if (v->width > veto->width) veto = v;
+    bool walls_agree = veto->width >= cfg_.min_plane_width;
+    for (const Vote* v : vetoes)
+      walls_agree = walls_agree && std::fabs(wrap_quarter(v->a - veto->a)) <= std::max(disagree_tolerance(*v), disagree_tolerance(*veto));
+    if (!walls_agree) {
       est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
                 "the room in front of it)";
       est.fraction = frame.fraction;
       est.vertical_area = frame.vertical_area;
       return est;
     }
+    float sc = 0.f, ss = 0.f, agree = 0.f;
+    for (const Vote& v : votes) {
+      if (v.inside || std::fabs(wrap_quarter(v.a - veto->a)) > cfg_.cluster_tolerance) continue;
+      sc += v.w * std::cos(4.f * v.a);
+      ss += v.w * std::sin(4.f * v.a);
+      agree += v.area;
+    }
+    frame.yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);
+    frame.T_manhattan_floor = manhattan_pose_from_yaw(frame.yaw);
+    frame.vertical_area = agree;
+    frame.fraction = total_area > 0.f ? agree / total_area : 0.f;
   }
   prev_yaw_ = frame.yaw;
   return frame;

@@ -266,7 +266,8 @@ struct ManhattanConfig {
     v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
           "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
           "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "
-          "a plane that makes the frame, and disagreeing with the frame modulo 90 deg, vetoes the frame (no frame)");
+          "a plane that makes the frame, and disagreeing with the frame modulo 90 deg, vetoes the frame: no frame, or "
+          "the frame of the walls agreeing with it when the widest such wall is min_plane_width wide");
     v.num(veto_min_width, "veto_min_width_cm", Unit::kCentimetre, 0, 1000,
           "narrowest wall that may veto a frame as above: a narrower plane's yaw is off by degrees");
     v.num(sliver_width, "sliver_width_cm", Unit::kCentimetre, 0, 200,

@@ -16,7 +16,8 @@
 /// veto_min_width wide) seen beyond a plane that makes the frame (structure_beyond_area of it, or
 /// half of a smaller one) and disagreeing with the frame modulo 90 degrees vetoes it: no frame
 /// (`why` says so) rather than the frame of furniture turned against the room; a sliver at the
-/// cut-off disagrees only beyond clipped_disagreement.
+/// cut-off disagrees only beyond clipped_disagreement. When the widest vetoing wall is
+/// min_plane_width wide, the walls agreeing with it give the frame instead.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -106,6 +107,7 @@ class ManhattanTracker {
   float max_range_ = 0.f;
   std::optional<float> prev_yaw_;
   std::vector<const Vote*> pair_candidates_;  // scratch: agreeing planes wide enough to make a pair
+  std::vector<const Vote*> vetoes_;           // scratch: the walls that veto the frame
   std::vector<Vote> votes_;               // scratch
   std::vector<FloorSample> floor_pts_;    // scratch
   std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
