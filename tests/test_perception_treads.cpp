@@ -7,6 +7,8 @@
 // ends beside the sliver in a stepped, slanted side edge.
 // And ascending treads leaving the view at its top border at a slant: a wedge of a few rows over
 // their riser, which reaches the border beside it (segmentation's split_slanted_border_band).
+// And a far tread seen as a strip of 3-4 rows that grew from a seed with its own normal: it takes
+// the floor's direction when its pixels accept it (segmentation's finalize).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -111,4 +113,12 @@ TEST(PerceptionTreads, AscendingTreadSliversAtTheTopBorderLeavingAtASlantAreRegi
   // region kept the sliver (segmentation's split_slanted_border_band).
   const Case cases[] = {{"handrails_open_sides_static", 11, 10, 4}, {"rotated_static", 17, 11, 5}};
   expect_treads_found(cases, 2, StairKind::kAscending);
+}
+
+TEST(PerceptionTreads, FarTreadStripsGrownWithTheirOwnNormalTakeADominantDirection) {
+  // Tread 7 of a descent at 3.8 m, 3-4 rows tall, grown from a seed with its own normal:
+  // its fit followed the disparity steps and came out 18 deg off the floor (segmentation's
+  // finalize: a strip less than a cell tall takes a dominant direction its pixels accept).
+  const Case cases[] = {{"people_static", 18, 1, 7}};
+  expect_treads_found(cases, 1, StairKind::kDescending);
 }

@@ -1908,6 +1908,23 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
   for (int r = 0; r < n; ++r) {
     Grow& g = grows[r];
     if (g.count < cfg_.region_min_pixels) continue;
+    // A strip grown with its own normal (from a cell or a fine seed, or left free by a merge) may
+    // lie on a dominant direction within the noise as well: a few rows fix its tilt no better than
+    // they fix a strip seed's (a far tread 3-4 rows tall came out 18 deg off, fitting the
+    // disparity steps). It takes the direction on the strip seeds' terms (best_direction, then
+    // region_plane's check that its own fit is not clearly better), and only when it is a strip:
+    // less than a cell tall (a band of h rows has a row variance h^2 / 12) and at least 8 times
+    // as wide as tall in row and column spread. Stubbier fragments leave both tilts open and
+    // borrow nothing (on the real kitchen, patches 8 rows by 40 columns would turn by up to
+    // 30 deg).
+    if (g.dir < 0 && g.m.n > 0) {
+      const double in = 1.0 / g.m.n;
+      const double su2 = (g.m.suu * in - (g.m.su * in) * (g.m.su * in)) * double(K_.fx) * K_.fx;
+      const double sv2 = (g.m.svv * in - (g.m.sv * in) * (g.m.sv * in)) * double(K_.fy) * K_.fy;
+      const double cs = cfg_.cell_size_px;
+      PlaneFit unused;
+      if (12.0 * sv2 < cs * cs && su2 >= 64.0 * sv2) g.dir = best_direction(g.m, unused);
+    }
     // Border refinement moved pixels: the direction is checked again on the final moments.
     const PlaneFit f = region_plane(g.m, g.dir);
     if (!f.ok || f.rms_w > kPlanarRms * tolerance_w()) {
