@@ -260,7 +260,8 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
       if (v->width > veto->width) veto = v;
     bool walls_agree = veto->width >= cfg_.min_plane_width;
     for (const Vote* v : vetoes)
-      walls_agree = walls_agree && std::fabs(wrap_quarter(v->a - veto->a)) <= std::max(disagree_tolerance(*v), disagree_tolerance(*veto));
+      walls_agree = walls_agree && std::fabs(wrap_quarter(v->a - veto->a)) <=
+                                       std::max(disagree_tolerance(*v), disagree_tolerance(*veto));
     if (!walls_agree) {
       est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
                 "the room in front of it)";
