@@ -104,3 +104,14 @@ TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
     EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index << " seed " << c.seed;
   }
 }
+
+// A wall standing on the floor with no floor beyond it, 0.29 m wide between shelves turned 17 deg
+// against the room: trusted from ManhattanConfig::min_bounding_width (0.2 m, as wide as a wall
+// that may veto a frame) it gives the room's frame (before, at 0.3 m: it only vetoed the
+// shelves' frame, and there was none).
+TEST(ManhattanFrame, NarrowWallOnTheFloorGivesTheFrame) {
+  const View v = run_view("shelves_static", 18, kSuiteSeed);
+  ASSERT_GE(v.truth.wall_or_riser_pixels, 500);
+  EXPECT_GE(v.yaw_err, 0.f) << "shelves_static #18: no frame (" << v.sc.manhattan_why << ")";
+  EXPECT_LE(v.yaw_err, 2.f) << "shelves_static #18";
+}

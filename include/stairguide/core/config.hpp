@@ -228,7 +228,7 @@ struct ManhattanConfig {
   float floor_beyond_margin = 0.25f;  ///< m, floor this far beyond a vertical plane shows it stands inside the room ...
   float floor_beyond_area = 0.05f;    ///< m^2, ... when this much floor lies there (furniture, risers; not a wall)
   float floor_beyond_height = 0.05f;  ///< m, horizontal planes within this of the floor count as floor for that test
-  float min_bounding_width = 0.3f;    ///< m, min_plane_width for planes standing on the floor with no floor beyond them (walls)
+  float min_bounding_width = 0.2f;    ///< m, min_plane_width for planes standing on the floor with no floor beyond them (walls)
   float range_clip_margin = 0.25f;    ///< m, a vertical plane with most points this near the depth cut-off cannot make a frame of walls alone
   float structure_beyond_area = 0.02f;  ///< m^2, other surfaces this large beyond a vertical plane make it no wall; a wall this large beyond a frame's plane may veto it ...
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
@@ -259,7 +259,8 @@ struct ManhattanConfig {
     v.num(floor_beyond_height, "floor_beyond_height_cm", Unit::kCentimetre, 0.5, 50,
           "horizontal planes within this of the floor count as floor for the test above");
     v.num(min_bounding_width, "min_bounding_width_cm", Unit::kCentimetre, 0, 1000,
-          "min_plane_width for vertical planes standing on the floor with no floor beyond them (walls)");
+          "min_plane_width for vertical planes standing on the floor with no floor beyond them (walls); "
+          "as narrow as a wall that may veto a frame (veto_min_width)");
     v.num(range_clip_margin, "range_clip_margin_cm", Unit::kCentimetre, 0, 200,
           "a vertical plane with most of its points this near the depth cut-off (capture max_range) cannot make a "
           "frame of walls alone: its fit may be biased");
