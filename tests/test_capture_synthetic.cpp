@@ -525,3 +525,15 @@ TEST(SyntheticSource, IntrinsicsScaleWithImageSize) {
   EXPECT_NEAR(rad2deg(t.camera_tilt_rad), 45.f, 1e-3f);
   EXPECT_EQ(src->frame_count(), 2);
 }
+
+// Beside an open-sided descent the lower floor lies under the upper floor's edge, as in a building:
+// the view shows it there, not a bottomless void with the lower floor's slab edge standing in it
+// (that edge, 0.2 m tall, counted as a wall in view for the Manhattan figure, 2772 px on this view
+// noise-free, and gave frames of its own).
+TEST(SyntheticPresets, LowerFloorRunsUnderAnOpenSidedDescent) {
+  RgbdFrame f;
+  FrameTruth t;
+  render_preset_frame("descending_static", 23, 20261123u, clean(), f, t);
+  ASSERT_EQ(t.stairs.size(), 1u);
+  EXPECT_LT(t.wall_or_riser_pixels, 200) << "a wall or riser face in view (the slab edge was 2772 px)";
+}

@@ -503,11 +503,19 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
             // The landing or floor after the last riser (tread `steps`) is wider than the flight,
             // and the truth counts its pixels beside the flight too (on a descent the part right
             // after the last riser hides behind the treads above, and what is seen of the lower
-            // floor is beside the flight): it is matched anywhere beyond the last riser. Treads
-            // of the flight must lie within its width.
-            if (k == st.steps && st.kind != StairKind::kCurb ? cs.z() < (st.steps - 1) * st.tread_m - 0.05f
-                                                             : std::fabs(cs.x()) > 0.5f * st.width_m + 0.1f)
+            // floor is beside the flight): it is matched by a region at its height reaching beyond
+            // the last riser (beside an open-sided descent the lower floor is one region from
+            // beside the flight to beyond it). Treads of the flight must lie within its width.
+            if (k == st.steps && st.kind != StairKind::kCurb) {
+              const float last_riser = (st.steps - 1) * st.tread_m - 0.05f;
+              if (cs.z() < last_riser) {
+                int beyond = 0;
+                for (const Eigen::Vector3f& q : R.points) beyond += (T_sc * q).z() >= last_riser;
+                if (beyond < std::min(100, st.visible_pixels[i] / 4)) continue;
+              }
+            } else if (std::fabs(cs.x()) > 0.5f * st.width_m + 0.1f) {
               continue;
+            }
             if (best < 0 || R.pixel_count > sc.regions[best].pixel_count) best = r, Hs = h_opt, by = b_opt;
           }
           if (best >= 0) break;
@@ -647,9 +655,9 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 215/226 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 212/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
-    //  - walls and risers seen too small or narrow to trust (7 views), and a 450 px strip of wall
+    //  - walls and risers seen too small or narrow to trust (6 views), and a 450 px strip of wall
     //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
     //    world through them, see test_walk_manhattan);
     //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
@@ -667,10 +675,13 @@ class TotalsCheck : public ::testing::Environment {
     // (and a 3 cm leg beside a person's front no longer made a "parallel pair": test_perception_manhattan);
     // 214/226 once a vetoing wall as wide as one that makes a frame alone gave the frame itself;
     // 215/226 once a wall on the floor with nothing beyond it was trusted from 20 cm wide (as wide
-    // as a wall that may veto a frame), not 30 (test_perception_manhattan).
+    // as a wall that may veto a frame), not 30 (test_perception_manhattan); 212/222 once the lower
+    // floor ran on under the upper floor beside an open-sided descent (test_capture_synthetic):
+    // its slab edge, 0.2 m tall in a bottomless void, had counted as a wall on 4 views (a miss on
+    // one, frames on the other three).
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 213) << "Manhattan frame within 2 deg where a wall or riser is in view (215/226)";
+    EXPECT_GE(A.manhattan_ok, 210) << "Manhattan frame within 2 deg where a wall or riser is in view (212/222)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }
@@ -686,7 +697,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     if (p.name == preset && p.default_frames > 1) length = p.default_frames, frames = 32;
   PresetFigures F;
   // SG_SEED=N runs the presets on another seed (the bounds below hold for the default one):
-  // measured Manhattan 218/236 on seed 7 and 236/250 on seed 8, no frame off with stairs in view.
+  // measured Manhattan 214/232 on seed 7 and 233/247 on seed 8, no frame off with stairs in view.
   const char* seed = getenv("SG_SEED");
   run_preset(preset, frames, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, length, F);
   (length <= 1 ? Totals::get() : Totals::sequences()).add(F);

@@ -184,8 +184,12 @@ int add_staircase(Scene& scene, const StairParams& p, Rng& rng) {
           box(V3(std::min(xa, xb), -total, -n), V3(std::max(xa, xb), 0.f, top_z0 + 4.f), fm, "floor");
         }
       }
-      box(V3(-6.f, -total - 0.2f, top_z0 - n), V3(6.f, -total, top_z0 + 8.f), floor_material(rng),
-          "lower_floor", N);
+      // The lower floor, the flight's last tread, runs on under the upper floor: beside an
+      // open-sided flight it is seen below the upper floor's edge (no bottomless void there, and no
+      // slab edge standing in one that would count as a wall).
+      const Material lower_m = floor_material(rng);
+      box(V3(-6.f, -total - 0.2f, top_z0 - n), V3(6.f, -total, top_z0 + 8.f), lower_m, "lower_floor", N);
+      box(V3(-6.f, -total - 0.2f, -8.f), V3(6.f, -total, top_z0 - n), lower_m, "floor");
     }
     if (!p.open_risers) {
       for (int k = 1; k < N; ++k) {

@@ -162,6 +162,13 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     // whose floor beyond is not seen): inside, like the planes with floor beyond them (below).
     const bool below = base < -cfg_.floor_beyond_height;
     votes.push_back({a, w, r.area, width, heading, below, grounded, clipped, static_cast<int>(k), sliver});
+    // A band a few centimetres thick (a handrail, a stringer, a riser strip) fixes its plane only up
+    // to a turn about its long axis. Along a horizontal axis (a riser strip) that turn moves the
+    // tilt and leaves the yaw; along an axis that slopes with a flight it moves the yaw too: the
+    // handrails beside an open-sided descent, seen against the floor below, made frames 4-5 deg off
+    // with the staircase in view (synthetic held-out views). Such a band votes but makes no frame.
+    votes.back().sloped_band = r.area < cfg_.band_max_thickness * r.rect_length_major &&
+                               std::fabs((R * r.rect_axis_major).y()) > std::sin(cfg_.band_min_slope);
   }
   if (votes.empty()) {
     est.why = "no vertical plane";
@@ -316,6 +323,7 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
     wsum_agree += v.w;
     // A plane seen mostly at the depth cut-off cannot make a frame of walls alone (see `clipped`).
     if (bounding_only && v.clipped) continue;
+    if (v.sloped_band) continue;
     // A wall standing on the floor is trusted from a narrower strip than other planes: people and
     // posts, whose yaw is off by degrees, have floor beside them or do not stand at its height.
     wide = wide || v.width >= min_width(v, bounding_only);

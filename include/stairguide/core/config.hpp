@@ -234,6 +234,8 @@ struct ManhattanConfig {
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
   float clipped_disagreement = 0.2617994f;  ///< rad, ... and contradicts another direction only beyond this (15 deg)
+  float band_max_thickness = 0.05f;     ///< m, a vertical plane thinner than this on average (area / length) is a band ...
+  float band_min_slope = 0.2617994f;    ///< rad, ... whose yaw is unreliable when its long axis slopes more than this (15 deg)
   float pair_min_width = 0.05f;         ///< m, without a wide plane, two agreeing parallel planes each this wide ...
   float pair_tolerance = 0.03490659f;   ///< rad, ... agreeing within this (2 deg) ...
   float pair_min_separation = 0.15f;    ///< m, ... make the frame trusted when this far apart (two risers, a wall and a riser) ...
@@ -277,6 +279,12 @@ struct ManhattanConfig {
     v.num(clipped_disagreement, "clipped_disagreement_deg", Unit::kDegree, 0.5, 45,
           "a sliver contradicts another direction, modulo 90 deg, only when it differs by more than this (other "
           "planes: cluster_tolerance)");
+    v.num(band_max_thickness, "band_max_thickness_cm", Unit::kCentimetre, 0, 100,
+          "a vertical plane thinner than this on average (area / length) is a band that fixes its plane only up to a "
+          "turn about its long axis ...");
+    v.num(band_min_slope, "band_min_slope_deg", Unit::kDegree, 0, 90,
+          "... which turns its yaw when that axis slopes more than this (a handrail or a stringer along a flight): "
+          "such a band votes but cannot make the frame, alone or in a pair");
     v.num(pair_min_width, "pair_min_width_cm", Unit::kCentimetre, 0, 1000,
           "without a wide vertical plane, two agreeing parallel planes each at least this wide (in the walls' frame: "
           "not at the depth cut-off) may make the frame trusted; narrower ones (a person's legs, an arm) have no yaw worth the name");

@@ -17,7 +17,9 @@
 /// half of a smaller one) and disagreeing with the frame modulo 90 degrees vetoes it: no frame
 /// (`why` says so) rather than the frame of furniture turned against the room; a sliver at the
 /// cut-off disagrees only beyond clipped_disagreement. When the widest vetoing wall is
-/// min_plane_width wide, the walls agreeing with it give the frame instead.
+/// min_plane_width wide, the walls agreeing with it give the frame instead. A thin band along a
+/// sloping axis (a handrail beside a flight) votes but cannot make a frame: its yaw turns with its
+/// plane about that axis.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -89,6 +91,9 @@ class ManhattanTracker {
     bool has_side = false;
     float nx = 0.f, nz = 0.f, limit = 0.f;
     float cx = 0.f, cz = 0.f;  // its centroid in the floor frame (set with has_side)
+    // A thin band along a sloping axis (a handrail, a stringer): its plane is fixed only up to a
+    // turn about that axis, which turns its yaw. It votes but makes no frame, alone or in a pair.
+    bool sloped_band = false;
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
