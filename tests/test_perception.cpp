@@ -655,9 +655,10 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 212/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 214/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
-    //  - walls and risers seen too small or narrow to trust (6 views), and a 450 px strip of wall
+    //  - walls and risers seen too small or narrow to trust, the image edges not confirming them
+    //    (4 views: single_step #20 has no vertical plane at all), and a 450 px strip of wall
     //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
     //    world through them, see test_walk_manhattan);
     //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
@@ -678,10 +679,11 @@ class TotalsCheck : public ::testing::Environment {
     // as a wall that may veto a frame), not 30 (test_perception_manhattan); 212/222 once the lower
     // floor ran on under the upper floor beside an open-sided descent (test_capture_synthetic):
     // its slab edge, 0.2 m tall in a bottomless void, had counted as a wall on 4 views (a miss on
-    // one, frames on the other three).
+    // one, frames on the other three); 214/222 once the image edges' compass confirmed planes too
+    // narrow or small to trust alone (people #7, ascending_short #15: test_perception_manhattan).
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 210) << "Manhattan frame within 2 deg where a wall or riser is in view (212/222)";
+    EXPECT_GE(A.manhattan_ok, 212) << "Manhattan frame within 2 deg where a wall or riser is in view (214/222)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }
@@ -697,7 +699,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     if (p.name == preset && p.default_frames > 1) length = p.default_frames, frames = 32;
   PresetFigures F;
   // SG_SEED=N runs the presets on another seed (the bounds below hold for the default one):
-  // measured Manhattan 214/232 on seed 7 and 233/247 on seed 8, no frame off with stairs in view.
+  // measured Manhattan 215/232 on seed 7 and 234/247 on seed 8, no frame off with stairs in view.
   const char* seed = getenv("SG_SEED");
   run_preset(preset, frames, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, length, F);
   (length <= 1 ? Totals::get() : Totals::sequences()).add(F);

@@ -55,7 +55,8 @@ float ManhattanHistogram::mode() const {
 ManhattanTracker::ManhattanTracker(const ManhattanConfig& config, float max_range)
     : cfg_(config), max_range_(max_range) {}
 
-ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera) {
+ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera,
+                                             const std::function<EdgeCompassResult()>& compass) {
   ManhattanEstimate est;
   const Eigen::Matrix3f R = T_floor_camera.linear();
   const float sin_tol = std::sin(cfg_.vertical_tolerance);
@@ -215,6 +216,19 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     bounding_only = false;
     frame = solve(votes, total_area, /*bounding_only=*/false);
   }
+  if (!frame.found && compass && cfg_.compass_min_support < 1.f) {
+    // The planes alone are too narrow or too small to trust: planes that the image's edges agree
+    // with (an independent witness) make the frame, checked by the walls below as any other.
+    const EdgeCompassResult c = compass();
+    ManhattanEstimate confirmed = confirm(votes, total_area, c);
+    if (!confirmed.found) {
+      frame.why += c.valid && c.support >= cfg_.compass_min_support
+                       ? "; the image edges' direction confirms no plane wide enough"
+                       : "; the image edges show no clear direction";
+      return frame;
+    }
+    frame = confirmed;
+  }
   if (!frame.found) return frame;
   // A wall seen beyond the planes that make the frame, disagreeing with them: they are furniture
   // turned against the room (a sofa, shelves, clutter filling the view) and the wall, too small,
@@ -290,6 +304,34 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   }
   prev_yaw_ = frame.yaw;
   return frame;
+}
+
+ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, float total_area,
+                                            const EdgeCompassResult& compass) const {
+  ManhattanEstimate est;
+  if (!compass.valid || compass.support < cfg_.compass_min_support) return est;
+  // The planes within compass_agreement of the edges' direction, one of them compass_min_width
+  // wide (narrower ones, a person's limbs, agree with anything to degrees). Bands along a slope
+  // and slivers at the depth cut-off, whose yaw may be off by degrees, neither make nor join it.
+  // The frame's yaw is the planes' (their weighted mean), not the edges': the compass only says
+  // which planes to believe.
+  float sc = 0.f, ss = 0.f, agree = 0.f;
+  bool wide = false;
+  for (const Vote& v : votes) {
+    if (v.sloped_band || v.sliver) continue;
+    if (std::fabs(wrap_quarter(v.a - compass.yaw)) > cfg_.compass_agreement) continue;
+    sc += v.w * std::cos(4.f * v.a);
+    ss += v.w * std::sin(4.f * v.a);
+    agree += v.area;
+    wide = wide || v.width >= cfg_.compass_min_width;
+  }
+  if (!wide) return est;
+  est.found = true;
+  est.yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);
+  est.T_manhattan_floor = manhattan_pose_from_yaw(est.yaw);
+  est.vertical_area = agree;
+  est.fraction = total_area > 0.f ? agree / total_area : 0.f;
+  return est;
 }
 
 float ManhattanTracker::disagree_tolerance(const Vote& v) const {

@@ -89,7 +89,9 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
     out.camera_roll = floor_est_.roll;
     out.floor_region = floor_est_.region;
     out.floor_tracked = floor_est_.tracked;
-    const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera);
+    const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera, [&]() {
+      return compass_.estimate(frame.gray, frame.intrinsics, out.T_floor_camera.linear());
+    });
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;
     out.manhattan_why = m.why;

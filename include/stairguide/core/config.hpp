@@ -240,6 +240,9 @@ struct ManhattanConfig {
   float pair_tolerance = 0.03490659f;   ///< rad, ... agreeing within this (2 deg) ...
   float pair_min_separation = 0.15f;    ///< m, ... make the frame trusted when this far apart (two risers, a wall and a riser) ...
   float carry_seconds = 10.f;         ///< s, a Manhattan frame seen this recently is carried by the odometry to views that make none (0: never)
+  float compass_min_support = 0.2f;     ///< share of the image edges' votes at their peak direction (edge_compass.hpp) for it to count; 1: never asked
+  float compass_agreement = 0.03490659f;  ///< rad, planes within this of that direction (modulo 90 deg) ... (2 deg)
+  float compass_min_width = 0.2f;       ///< m, ... make the frame when one of them is this wide, even if too narrow or small to be trusted alone
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -293,6 +296,14 @@ struct ManhattanConfig {
     v.num(pair_min_separation, "pair_min_separation_cm", Unit::kCentimetre, 0, 1000,
           "such two planes are distinct (a flight's risers, a wall and a riser) when this far apart along their normal; "
           "nearer, only as strips of one plane on one line (within pair_tolerance), as wide as they span together");
+    v.num(compass_min_support, "compass_min_support", Unit::kNone, 0, 1,
+          "when the vertical planes alone make no trusted frame, the image edges' dominant horizontal direction "
+          "(given the floor's vertical) is asked; it counts when this share of the edges' votes lies at its peak "
+          "(a uniform spread gives 0.04); 1: never ask");
+    v.num(compass_agreement, "compass_agreement_deg", Unit::kDegree, 0.1, 45,
+          "vertical planes within this of that direction (modulo 90 deg) ...");
+    v.num(compass_min_width, "compass_min_width_cm", Unit::kCentimetre, 0, 1000,
+          "... make the frame when one of them is this wide, although too narrow or too small to be trusted alone");
     v.num(carry_seconds, "carry_s", Unit::kSecond, 0, 600,
           "seconds a Manhattan frame seen in one view is carried by the odometry to later views whose own walls make "
           "none (walls do not turn when the user does); 0: never");

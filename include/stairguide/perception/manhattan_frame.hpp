@@ -20,15 +20,20 @@
 /// min_plane_width wide, the walls agreeing with it give the frame instead. A thin band along a
 /// sloping axis (a handrail beside a flight) votes but cannot make a frame: its yaw turns with its
 /// plane about that axis.
+/// When the planes alone make no trusted frame, the image edges' direction (edge_compass.hpp, an
+/// independent witness) is asked: planes agreeing with it within compass_agreement, one of them
+/// compass_min_width wide, make the frame (their own yaw), which the walls may still veto.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "stairguide/core/config.hpp"
 #include "stairguide/core/types.hpp"
+#include "stairguide/perception/edge_compass.hpp"
 #include "stairguide/perception/scene.hpp"
 
 namespace stairguide {
@@ -74,7 +79,11 @@ class ManhattanTracker {
   explicit ManhattanTracker(const ManhattanConfig& config = {}, float max_range = 0.f);
 
   /// Estimates the Manhattan frame from the vertical planes among `regions`, given the floor.
-  ManhattanEstimate estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
+  /// `compass`, when given, is asked (once, only when the planes alone make no trusted frame) for
+  /// the image edges' direction (edge_compass.hpp): agreeing planes too narrow or too small to be
+  /// trusted alone then make the frame (ManhattanConfig::compass_*).
+  ManhattanEstimate estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera,
+                             const std::function<EdgeCompassResult()>& compass = {});
   void reset() { prev_yaw_.reset(); }
 
  private:
@@ -107,6 +116,8 @@ class ManhattanTracker {
   /// Width from which an agreeing plane makes the frame trusted on its own.
   float min_width(const Vote& v, bool bounding_only) const;
   ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, bool bounding_only);
+  /// The frame of the planes agreeing with the image edges' direction (see estimate()).
+  ManhattanEstimate confirm(const std::vector<Vote>& votes, float total_area, const EdgeCompassResult& compass) const;
 
   ManhattanConfig cfg_;
   float max_range_ = 0.f;

@@ -94,6 +94,7 @@ class Perception {
   Segmentation segmentation_;
   FloorDetector floor_;
   ManhattanTracker manhattan_;
+  EdgeCompass compass_;
   ClassificationConfig classification_;
   FloorEstimate floor_est_;
   ManhattanConfig manhattan_cfg_;
