@@ -655,10 +655,10 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 214/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // 215/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
     // in view. The misses:
-    //  - walls and risers seen too small or narrow to trust, the image edges not confirming them
-    //    (4 views: single_step #20 has no vertical plane at all), and a 450 px strip of wall
+    //  - walls and risers seen too small, narrow or far to trust, the image edges showing no clear
+    //    direction to confirm them (3 views), and a 450 px strip of wall
     //    while turning (8 walking views: in the daemon the odometry carries the frame held in the
     //    world through them, see test_walk_manhattan);
     //  - a sofa, shelf or clutter turned against the room fills the view and the wall behind it
@@ -680,10 +680,12 @@ class TotalsCheck : public ::testing::Environment {
     // floor ran on under the upper floor beside an open-sided descent (test_capture_synthetic):
     // its slab edge, 0.2 m tall in a bottomless void, had counted as a wall on 4 views (a miss on
     // one, frames on the other three); 214/222 once the image edges' compass confirmed planes too
-    // narrow or small to trust alone (people #7, ascending_short #15: test_perception_manhattan).
+    // narrow or small to trust alone (people #7, ascending_short #15: test_perception_manhattan);
+    // 215/222 once a band along a level axis tilted beyond 10 deg by its fit joined them
+    // (single_step #20, a riser's corner at the image edge).
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 212) << "Manhattan frame within 2 deg where a wall or riser is in view (214/222)";
+    EXPECT_GE(A.manhattan_ok, 213) << "Manhattan frame within 2 deg where a wall or riser is in view (215/222)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, now 1)";
   }

@@ -164,28 +164,49 @@ Pose level_camera() {
   return T;
 }
 
-/// A vertical plane `width` x 0.3 m, floating 0.85 m above the floor 2 m ahead (no floor seen,
-/// not standing on it: a cupboard's front, a person), its normal at `yaw` (rad) from z_F,
-/// facing the camera; points every 2 cm, in camera coordinates.
-PlaneRegion vertical_patch(const Pose& T_floor_camera, float yaw, float width) {
+/// A planar rectangle `width` (along `along_f`, horizontal) x `height` (along `across_f`) centred
+/// at `c_f`, normal `n_f` (floor frame, towards the camera); points every `step` m, in camera
+/// coordinates, with what ManhattanTracker reads of a region.
+PlaneRegion rectangle(const Pose& T_floor_camera, const Eigen::Vector3f& c_f, const Eigen::Vector3f& n_f,
+                      const Eigen::Vector3f& along_f, const Eigen::Vector3f& across_f, float width, float height,
+                      float step) {
   PlaneRegion r;
-  const Eigen::Vector3f n_f(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
-  const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
-  const Eigen::Vector3f c_f(0.f, 1.0f, 2.f);
   const Pose T_cf = T_floor_camera.inverse();
-  for (float a = -0.5f * width; a <= 0.5f * width + 1e-4f; a += 0.02f)
-    for (float h = -0.15f; h <= 0.15f + 1e-4f; h += 0.02f)
-      r.points.push_back(T_cf * (c_f + a * along_f + Eigen::Vector3f(0.f, h, 0.f)));
+  for (float a = -0.5f * width; a <= 0.5f * width + 1e-4f; a += step)
+    for (float h = -0.5f * height; h <= 0.5f * height + 1e-4f; h += step)
+      r.points.push_back(T_cf * (c_f + a * along_f + h * across_f));
   r.normal = T_cf.linear() * n_f;
   r.centroid = T_cf * c_f;
   r.offset = -r.normal.dot(r.centroid);
   r.pixel_count = static_cast<int>(r.points.size());
-  r.area = width * 0.3f;
-  r.rect_axis_major = T_cf.linear() * along_f;
-  r.rect_axis_minor = T_cf.linear() * Eigen::Vector3f::UnitY();
-  r.rect_length_major = std::max(width, 0.3f);
-  r.rect_length_minor = std::min(width, 0.3f);
+  r.area = width * height;
+  const bool wide = width >= height;
+  r.rect_axis_major = T_cf.linear() * (wide ? along_f : across_f);
+  r.rect_axis_minor = T_cf.linear() * (wide ? across_f : along_f);
+  r.rect_length_major = std::max(width, height);
+  r.rect_length_minor = std::min(width, height);
   return r;
+}
+
+/// A vertical plane `width` x 0.3 m, floating 0.85 m above the floor 2 m ahead (no floor seen,
+/// not standing on it: a cupboard's front, a person), its normal at `yaw` (rad) from z_F,
+/// facing the camera; points every 2 cm.
+PlaneRegion vertical_patch(const Pose& T_floor_camera, float yaw, float width) {
+  const Eigen::Vector3f n_f(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
+  const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 1.0f, 2.f), n_f, along_f, Eigen::Vector3f::UnitY(), width,
+                   0.3f, 0.02f);
+}
+
+/// A band `length` x 0.07 m along a level axis at `yaw` (rad), its plane tilted `tilt` (rad) from
+/// vertical about that axis (a riser's strip whose fit the noise turned), 0.1 m above the floor
+/// 2 m ahead, facing the camera; points every 1 cm.
+PlaneRegion tilted_band(const Pose& T_floor_camera, float yaw, float tilt, float length) {
+  const Eigen::Vector3f n_h(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
+  const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
+  const Eigen::Vector3f n_f = std::cos(tilt) * n_h + std::sin(tilt) * Eigen::Vector3f::UnitY();
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 0.135f, 2.f), n_f, along_f, n_f.cross(along_f).normalized(),
+                   length, 0.07f, 0.01f);
 }
 
 }  // namespace
@@ -236,4 +257,57 @@ TEST(ManhattanFrame, CompassConfirmsOnlyAgreeingPlanes) {
     const ManhattanEstimate e = m.estimate({vertical_patch(T, yaw, 0.16f)}, T, compass_at(yaw, 0.4f));
     EXPECT_FALSE(e.found) << "a plane narrower than compass_min_width was confirmed";
   }
+}
+
+// A band along a level axis (a riser's strip 7 cm tall) fixes its plane only up to a turn about
+// that axis: tilted 13 deg from vertical by its fit, its axis still gives the yaw. It joins the
+// planes the image edges confirm (heading from the axis), and makes no frame without them; tilted
+// beyond level_band_max_tilt, or along a sloping axis, it is no vertical plane at all.
+TEST(ManhattanFrame, TiltedLevelBandJoinsOnlyConfirmedFrames) {
+  const Pose T = level_camera();
+  const float yaw = -0.2f;
+  auto compass_at = [](float y) {
+    return [y]() {
+      EdgeCompassResult c;
+      c.valid = true;
+      c.yaw = y;
+      c.support = 0.4f;
+      c.weight = 1.f;
+      return c;
+    };
+  };
+  const ManhattanConfig cfg;
+  {
+    ManhattanTracker m(cfg);
+    EXPECT_FALSE(m.estimate({tilted_band(T, yaw, 13.f * 3.14159265f / 180.f, 0.4f)}, T).found)
+        << "a tilted band made a frame without the compass";
+  }
+  {
+    ManhattanTracker m(cfg);
+    const ManhattanEstimate e =
+        m.estimate({tilted_band(T, yaw, 13.f * 3.14159265f / 180.f, 0.4f)}, T, compass_at(yaw + 0.02f));
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_NEAR(e.yaw, yaw, 1e-3f) << "the band's heading is its axis's";
+  }
+  {
+    ManhattanTracker m(cfg);
+    const float too_tilted = cfg.level_band_max_tilt + 0.05f;
+    EXPECT_FALSE(m.estimate({tilted_band(T, yaw, too_tilted, 0.4f)}, T, compass_at(yaw)).found)
+        << "a band tilted beyond level_band_max_tilt was confirmed";
+  }
+}
+
+// On the suite's seed, single_step #20 shows only a corner of the step's riser at the image's
+// edge: a band 0.4 m x 7 cm whose fit is 13 deg from vertical, its yaw 0.3 deg off. With the
+// image edges confirming it, it gives the frame; taken as vertical only within
+// vertical_tolerance (level_band_max_tilt no larger), the view had no vertical plane at all.
+TEST(ManhattanFrame, RiserCornerAtTheImageEdgeGivesTheFrame) {
+  const View v = run_view("single_step_static", 20, kSuiteSeed);
+  ASSERT_GE(v.truth.wall_or_riser_pixels, 200);
+  EXPECT_GE(v.yaw_err, 0.f) << "single_step_static #20: no frame (" << v.sc.manhattan_why << ")";
+  EXPECT_LE(v.yaw_err, 2.f) << "single_step_static #20";
+  ManhattanConfig vertical_only;
+  vertical_only.level_band_max_tilt = vertical_only.vertical_tolerance;
+  const View w = run_view("single_step_static", 20, kSuiteSeed, vertical_only);
+  EXPECT_LT(w.yaw_err, 0.f) << "without the tilted band: a frame " << w.yaw_err << " deg off";
 }

@@ -125,8 +125,26 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     const PlaneRegion& r = regions[k];
     total_area += r.area;
     const Eigen::Vector3f nf = R * r.normal;
-    if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
-    const float heading = std::atan2(nf.x(), nf.z());
+    if (r.points.empty()) continue;
+    // A band a few centimetres tall along a level axis (a riser's strip at the image's edge, a
+    // kerb's face) fixes its plane only up to a turn about that axis: its tilt may be off by
+    // degrees, its axis and so its yaw are not (a single step's riser corner, 7 cm tall and 0.4 m
+    // long, 13 deg from vertical, yaw 0.3 deg off). Tilted more than vertical_tolerance, it votes
+    // only where the image edges confirm it (confirm()), its heading taken from the axis.
+    bool tilted = false;
+    float heading = std::atan2(nf.x(), nf.z());
+    if (std::fabs(nf.y()) > sin_tol) {
+      const Eigen::Vector3f axis = R * r.rect_axis_major;
+      if (std::fabs(nf.y()) > std::sin(cfg_.level_band_max_tilt) ||
+          !(r.rect_length_minor < cfg_.level_band_max_height) ||
+          std::fabs(axis.y()) > std::sin(cfg_.level_band_max_slope))
+        continue;
+      tilted = true;
+      // The horizontal normal of the axis, on the side of the plane's normal.
+      Eigen::Vector2f h(axis.z(), -axis.x());
+      if (h.x() * nf.x() + h.y() * nf.z() < 0.f) h = -h;
+      heading = std::atan2(h.x(), h.y());
+    }
     const float a = wrap_quarter(heading);
     // Horizontal width of the region: the spread of its points along the horizontal in its plane;
     // the height of its lowest point; how many of its points lie at the depth cut-off.
@@ -168,6 +186,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     // tilt and leaves the yaw; along an axis that slopes with a flight it moves the yaw too: the
     // handrails beside an open-sided descent, seen against the floor below, made frames 4-5 deg off
     // with the staircase in view (synthetic held-out views). Such a band votes but makes no frame.
+    votes.back().tilted = tilted;
     votes.back().sloped_band = r.area < cfg_.band_max_thickness * r.rect_length_major &&
                                std::fabs((R * r.rect_axis_major).y()) > std::sin(cfg_.band_min_slope);
   }
@@ -208,7 +227,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   // Planes that bound the room (walls) make the frame when they can; the rest (furniture turned
   // against the room, risers, people) vote only when the bounding planes alone make no frame.
   bool any_bounding = false;
-  for (const Vote& v : votes) any_bounding = any_bounding || !v.inside;
+  for (const Vote& v : votes) any_bounding = any_bounding || (!v.inside && !v.tilted);
   bool bounding_only = any_bounding;
   ManhattanEstimate frame;
   if (any_bounding) frame = solve(votes, total_area, /*bounding_only=*/true);
@@ -247,6 +266,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   std::vector<const Vote*>& vetoes = vetoes_;  // the walls that veto the frame
   vetoes.clear();
   for (const Vote& vf : votes) {
+    if (vf.tilted) continue;
     // A wall stands on the floor or goes on past the depth cut-off; a plane floating above the
     // floor and ending within range with nothing seen behind it may be a person's upper body.
     if (!vf.grounded && !vf.clipped) continue;
@@ -258,7 +278,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     const std::size_t f0 = first[static_cast<std::size_t>(vf.region)];
     const std::size_t f1 = first[static_cast<std::size_t>(vf.region) + 1];
     for (const Vote& vn : votes) {
-      if (&vn == &vf || !vn.has_side) continue;
+      if (&vn == &vf || !vn.has_side || vn.tilted) continue;
       if (bounding_only && vn.inside) continue;  // did not make this frame
       if (std::fabs(wrap_quarter(vn.a - frame.yaw)) > cfg_.cluster_tolerance) continue;
       if (std::fabs(wrap_quarter(vf.a - vn.a)) <= std::max(disagree_tolerance(vn), disagree_tolerance(vf))) continue;
@@ -292,7 +312,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     }
     float sc = 0.f, ss = 0.f, agree = 0.f;
     for (const Vote& v : votes) {
-      if (v.inside || std::fabs(wrap_quarter(v.a - veto->a)) > cfg_.cluster_tolerance) continue;
+      if (v.inside || v.tilted || std::fabs(wrap_quarter(v.a - veto->a)) > cfg_.cluster_tolerance) continue;
       sc += v.w * std::cos(4.f * v.a);
       ss += v.w * std::sin(4.f * v.a);
       agree += v.area;
@@ -349,7 +369,7 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
   // Votes: angle of each vertical normal in the floor plane, modulo 90 degrees.
   ManhattanHistogram hist;
   for (const Vote& v : votes)
-    if (!(bounding_only && v.inside)) hist.add(v.a, v.w);
+    if (!(bounding_only && v.inside) && !v.tilted) hist.add(v.a, v.w);
   const float mode = hist.mode();
   // Circular mean of 4*angle among votes near the mode (period 90 degrees).
   float sc = 0.f, ss = 0.f, agree = 0.f, wsum_agree = 0.f;
@@ -357,7 +377,7 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
   std::vector<const Vote*>& candidates = pair_candidates_;
   candidates.clear();
   for (const Vote& v : votes) {
-    if (bounding_only && v.inside) continue;
+    if ((bounding_only && v.inside) || v.tilted) continue;
     if (std::fabs(wrap_quarter(v.a - mode)) > cfg_.cluster_tolerance) continue;
     sc += v.w * std::cos(4.f * v.a);
     ss += v.w * std::sin(4.f * v.a);

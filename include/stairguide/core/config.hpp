@@ -236,6 +236,9 @@ struct ManhattanConfig {
   float clipped_disagreement = 0.2617994f;  ///< rad, ... and contradicts another direction only beyond this (15 deg)
   float band_max_thickness = 0.05f;     ///< m, a vertical plane thinner than this on average (area / length) is a band ...
   float band_min_slope = 0.2617994f;    ///< rad, ... whose yaw is unreliable when its long axis slopes more than this (15 deg)
+  float level_band_max_height = 0.1f;        ///< m, a plane narrower than this in-plane is a band ...
+  float level_band_max_tilt = 0.43633231f;   ///< rad, ... which along a level axis may tilt this far from vertical (25 deg) ...
+  float level_band_max_slope = 0.13962634f;  ///< rad, ... when its axis slopes less than this (8 deg): it joins planes the image edges confirm
   float pair_min_width = 0.05f;         ///< m, without a wide plane, two agreeing parallel planes each this wide ...
   float pair_tolerance = 0.03490659f;   ///< rad, ... agreeing within this (2 deg) ...
   float pair_min_separation = 0.15f;    ///< m, ... make the frame trusted when this far apart (two risers, a wall and a riser) ...
@@ -288,6 +291,14 @@ struct ManhattanConfig {
     v.num(band_min_slope, "band_min_slope_deg", Unit::kDegree, 0, 90,
           "... which turns its yaw when that axis slopes more than this (a handrail or a stringer along a flight): "
           "such a band votes but cannot make the frame, alone or in a pair");
+    v.num(level_band_max_height, "level_band_max_height_cm", Unit::kCentimetre, 0, 100,
+          "a plane narrower than this (its bounding rectangle's short side) is a band that fixes its plane only up to "
+          "a turn about its long axis ...");
+    v.num(level_band_max_tilt, "level_band_max_tilt_deg", Unit::kDegree, 0, 90,
+          "... so along a level axis its tilt may be off, its yaw is not: tilted up to this from vertical ...");
+    v.num(level_band_max_slope, "level_band_max_slope_deg", Unit::kDegree, 0, 45,
+          "... with its axis sloping less than this, it joins the vertical planes that the image edges confirm "
+          "(compass_*), its heading taken from its axis; it makes no frame otherwise");
     v.num(pair_min_width, "pair_min_width_cm", Unit::kCentimetre, 0, 1000,
           "without a wide vertical plane, two agreeing parallel planes each at least this wide (in the walls' frame: "
           "not at the depth cut-off) may make the frame trusted; narrower ones (a person's legs, an arm) have no yaw worth the name");

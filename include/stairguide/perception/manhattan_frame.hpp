@@ -103,6 +103,9 @@ class ManhattanTracker {
     // A thin band along a sloping axis (a handrail, a stringer): its plane is fixed only up to a
     // turn about that axis, which turns its yaw. It votes but makes no frame, alone or in a pair.
     bool sloped_band = false;
+    // A band along a level axis tilted beyond vertical_tolerance: its heading is its axis's; it
+    // only joins planes that the image edges confirm (confirm()).
+    bool tilted = false;
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
