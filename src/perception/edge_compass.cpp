@@ -90,11 +90,11 @@ EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrins
       const float c2 = dxy / aniso;
       const float gcos = std::sqrt(std::max(0.f, 0.5f * (1.f + c2)));
       const float gsin = std::copysign(std::sqrt(std::max(0.f, 0.5f * (1.f - c2))), xyu);
-      // The edge's interpretation plane holds the ray r and the ray's displacement along the
-      // edge t; its normal is r x t.
-      const Eigen::Vector3f r((static_cast<float>(u) - Kh.cx) * inv_fx, y, 1.f);
+      // The edge's interpretation plane holds the viewing ray and the ray's displacement along
+      // the edge t; its normal is ray x t.
+      const Eigen::Vector3f ray((static_cast<float>(u) - Kh.cx) * inv_fx, y, 1.f);
       const Eigen::Vector3f t(-gsin * inv_fx, gcos * inv_fy, 0.f);
-      const Eigen::Vector3f m = r.cross(t);
+      const Eigen::Vector3f m = ray.cross(t);
       const float mx = m.dot(fx_c), my = m.dot(up_c), mz = m.dot(fz_c);
       const float n2 = mx * mx + my * my + mz * mz;
       if (!(n2 > 0.f)) continue;
