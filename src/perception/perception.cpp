@@ -89,8 +89,15 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
     out.camera_roll = floor_est_.roll;
     out.floor_region = floor_est_.region;
     out.floor_tracked = floor_est_.tracked;
-    const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera, [&]() {
-      return compass_.estimate(frame.gray, frame.intrinsics, out.T_floor_camera.linear());
+    // The compass is asked lazily, through a lambda holding one reference: std::function keeps so
+    // small a callable in place, with no allocation per frame.
+    const struct {
+      EdgeCompass& compass;
+      const RgbdFrame& frame;
+      const Pose& T_floor_camera;
+    } ask{compass_, frame, out.T_floor_camera};
+    const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera, [&ask]() {
+      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T_floor_camera.linear());
     });
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;
