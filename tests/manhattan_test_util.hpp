@@ -21,12 +21,13 @@ inline float wrap45(float a) {
 }
 
 /// Yaw error (degrees) of the reported k_M against the world's axes or any staircase's, modulo 90
-/// degrees (a staircase may be turned against the room); < 0 when no frame is reported.
+/// degrees (a staircase may be turned against the room); < 0 when no frame is reported. The frame
+/// is measured about its own upright frame (the floor's, or a floor-like plane's without a floor).
 inline float manhattan_yaw_error_deg(const stairguide::SceneResult& sc, const stairguide::FrameTruth& truth) {
-  if (!sc.floor_found || !sc.manhattan_found) return -1.f;
+  if (!sc.manhattan_found) return -1.f;
   const Eigen::Matrix3f Rwc = truth.T_world_camera.linear();
   const Eigen::Vector3f kF(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw));
-  const Eigen::Vector3f kW = Rwc * (sc.T_floor_camera.linear().transpose() * kF);
+  const Eigen::Vector3f kW = Rwc * (sc.T_upright_camera.linear().transpose() * kF);
   float err = std::fabs(wrap45(std::atan2(kW.y(), kW.x())));
   for (const stairguide::StairTruth& st : truth.stairs) {
     const Eigen::Vector3f zs = Rwc * st.T_camera_stair.linear().col(2);
@@ -40,7 +41,7 @@ struct WorldManhattan {
   std::vector<Eigen::Vector3f> k, up;
   /// Adds a view's frame, `R_wc` being its camera's orientation in the world.
   void add(const stairguide::SceneResult& sc, const Eigen::Matrix3f& R_wc) {
-    const Eigen::Matrix3f R_cf = sc.T_floor_camera.linear().transpose();  // floor into camera
+    const Eigen::Matrix3f R_cf = sc.T_upright_camera.linear().transpose();  // upright (floor) into camera
     k.push_back(R_wc * (R_cf * Eigen::Vector3f(std::sin(sc.manhattan_yaw), 0.f, std::cos(sc.manhattan_yaw))));
     up.push_back(R_wc * (R_cf * Eigen::Vector3f::UnitY()));
   }

@@ -165,7 +165,10 @@ TEST(WalkManhattanReal, KitchenFrameHeldByOurOdometryHoldsStillInTheWorld) {
       const TimedPose* truth = nullptr;
       for (const TimedPose& t : truth_poses)
         if (std::fabs(t.timestamp - f.timestamp) < 0.005) truth = &t;
-      if (!truth || !sc.floor_found || !sc.manhattan_found) continue;
+      // Frames measured without a floor (about a floor-like plane refused as the floor) count too:
+      // taking the largest floor-like plane when none was chosen gave 47 views frames up to 8.9 deg
+      // off here (p95 3.1 deg held), while no synthetic view was off.
+      if (!truth || !sc.manhattan_found) continue;
       world.add(sc, truth->T_world_camera.linear());
       S.held += sc.manhattan_carried;
     }

@@ -504,6 +504,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
                        (stair_from_view_edge(regions, chosen, near, frame.depth.cols) || middle_of_stack(regions, chosen, near));
     // Cold, passing every other check: the user may stand on a level above it at the view's edge.
     if (clear && !stair && !tracked && level_above_underfoot(regions, chosen, frame.depth.cols, frame.depth.rows)) {
+      est.level_region = chosen;
       est.why = "the user may stand on the level above, seen at the view's edge";
       return lost(est);
     }
@@ -524,6 +525,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     }
     if (!clear) ++rejected_below;
     else ++rejected_stair;
+    if (rejected_below + rejected_stair == 1) est.level_region = chosen;
     const Eigen::Vector3f n0 = f.normal;
     const float d0 = f.offset;
     // A tread of a descent (a level a riser below it ahead, the floor a riser above): every plane
@@ -552,7 +554,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
   }
   const PlaneRegion& f = regions[chosen];
   est.found = true;
-  est.region = chosen;
+  est.region = est.level_region = chosen;
   est.normal = f.normal;
   est.offset = f.offset;
   est.height = f.offset;

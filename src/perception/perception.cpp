@@ -64,6 +64,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.manhattan_yaw = out.manhattan_fraction = 0.f;
   out.manhattan_carried = false;
   out.manhattan_carried_age = 0.f;
+  out.T_upright_camera = Pose::Identity();
+  out.manhattan_without_floor = false;
   out.timings = {};
 
   std::string why;
@@ -81,23 +83,19 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
   out.frames_since_floor = floor_.frames_since_floor();
   const auto t2 = Clock::now();
   out.timings.floor_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
-  if (floor_est_.found) {
-    out.floor_found = true;
-    out.T_floor_camera = floor_est_.T_floor_camera;
-    out.camera_height = floor_est_.height;
-    out.camera_tilt = floor_est_.tilt;
-    out.camera_roll = floor_est_.roll;
-    out.floor_region = floor_est_.region;
-    out.floor_tracked = floor_est_.tracked;
-    // The compass is asked lazily, through a lambda holding one reference: std::function keeps so
-    // small a callable in place, with no allocation per frame.
+  // The Manhattan frame about an upright frame's vertical (the floor's, or without a floor that of
+  // a floor-like plane refused as the floor); the image edges' compass is asked lazily, through a
+  // lambda holding one reference: std::function keeps so small a callable in place, with no
+  // allocation per frame.
+  auto manhattan = [&](const Pose& T_upright_camera) {
+    out.T_upright_camera = T_upright_camera;
     const struct {
       EdgeCompass& compass;
       const RgbdFrame& frame;
-      const Pose& T_floor_camera;
-    } ask{compass_, frame, out.T_floor_camera};
-    const ManhattanEstimate m = manhattan_.estimate(out.regions, out.T_floor_camera, [&ask]() {
-      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T_floor_camera.linear());
+      const Pose& T;
+    } ask{compass_, frame, T_upright_camera};
+    const ManhattanEstimate m = manhattan_.estimate(out.regions, T_upright_camera, [&ask]() {
+      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T.linear());
     });
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;
@@ -107,9 +105,28 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
       out.T_manhattan_floor = m.T_manhattan_floor;
       last_yaw_ = m.yaw;
     }
+  };
+  if (floor_est_.found) {
+    out.floor_found = true;
+    out.T_floor_camera = floor_est_.T_floor_camera;
+    out.camera_height = floor_est_.height;
+    out.camera_tilt = floor_est_.tilt;
+    out.camera_roll = floor_est_.roll;
+    out.floor_region = floor_est_.region;
+    out.floor_tracked = floor_est_.tracked;
+    manhattan(out.T_floor_camera);
   } else {
     out.why = "no floor: " + floor_est_.why;
-    out.manhattan_why = "no floor";
+    if (manhattan_cfg_.without_floor && floor_est_.level_region >= 0) {
+      // Refused as the floor for where it lies (a tread, a seat: the user's level is in doubt),
+      // a floor-like plane is still level: the walls and risers are upright about its normal.
+      const PlaneRegion& level = out.regions[static_cast<std::size_t>(floor_est_.level_region)];
+      manhattan(floor_pose_from_plane(level.normal, level.offset));
+      out.manhattan_without_floor = out.manhattan_found;
+      if (!out.manhattan_found) out.manhattan_why = "no floor; about a floor-like plane's vertical: " + out.manhattan_why;
+    } else {
+      out.manhattan_why = "no floor";
+    }
   }
   const auto t3 = Clock::now();
   out.timings.manhattan_ms = std::chrono::duration<double, std::milli>(t3 - t2).count();

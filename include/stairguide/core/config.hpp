@@ -242,6 +242,7 @@ struct ManhattanConfig {
   float pair_min_width = 0.05f;         ///< m, without a wide plane, two agreeing parallel planes each this wide ...
   float pair_tolerance = 0.03490659f;   ///< rad, ... agreeing within this (2 deg) ...
   float pair_min_separation = 0.15f;    ///< m, ... make the frame trusted when this far apart (two risers, a wall and a riser) ...
+  bool without_floor = true;          ///< with no floor found, measure the frame about a floor-like plane refused as the floor
   float carry_seconds = 10.f;         ///< s, a Manhattan frame seen this recently is carried by the odometry to views that make none (0: never)
   float compass_min_support = 0.2f;     ///< share of the image edges' votes at their peak direction (edge_compass.hpp) for it to count; 1: never asked
   float compass_agreement = 0.03490659f;  ///< rad, planes within this of that direction (modulo 90 deg) ... (2 deg)
@@ -315,6 +316,9 @@ struct ManhattanConfig {
           "vertical planes within this of that direction (modulo 90 deg) ...");
     v.num(compass_min_width, "compass_min_width_cm", Unit::kCentimetre, 0, 1000,
           "... make the frame when one of them is this wide, although too narrow or too small to be trusted alone");
+    v.flag(without_floor, "without_floor",
+           "with no floor found, measure the frame about the vertical of a floor-like plane the floor's checks refused "
+           "(a tread, a seat: which level the user stands on is in doubt, which way is up is not)");
     v.num(carry_seconds, "carry_s", Unit::kSecond, 0, 600,
           "seconds a Manhattan frame seen in one view is carried by the odometry to later views whose own walls make "
           "none (walls do not turn when the user does); 0: never");

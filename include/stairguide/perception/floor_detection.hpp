@@ -42,6 +42,13 @@ struct FloorEstimate {
   bool found = false;
   std::string why;                    ///< when !found
   int region = -1;                    ///< index of the floor region
+  /// When !found: the plane the rules chose (a chest camera's orientation and height, the largest
+  /// footprint near the user) and the checks then refused first for where it lies. It may be a
+  /// tread or a seat, but its normal is still the vertical (perception measures the Manhattan
+  /// frame about it); -1 when none was chosen (small planes' normals are not trusted for that: on
+  /// the real kitchen, worktop and floor patches too small to be chosen gave frames up to 9 deg
+  /// off). When found, the floor's region.
+  int level_region = -1;
   bool tracked = false;               ///< chosen by agreement with the previous frame's floor
   Eigen::Vector3f normal = -Eigen::Vector3f::UnitY();  ///< floor up direction, camera frame
   float offset = 0.f;                 ///< n.p + offset = 0 for floor points; = camera height

@@ -87,6 +87,13 @@ struct SceneResult {
   Pose T_manhattan_floor = Pose::Identity();  ///< floor frame into Manhattan frame M (rotation about y)
   float manhattan_yaw = 0.f;              ///< rad, angle of k_M from z_F about y_F
   float manhattan_fraction = 0.f;         ///< share of points on Manhattan-aligned vertical planes
+  /// Camera into the upright frame (x left, y up, z forward, as F) the Manhattan yaw is measured
+  /// about: T_floor_camera when the floor is found. With no floor found, a floor-like plane the
+  /// floor's checks refused (it may be a tread or a seat: FloorEstimate::level_region) still gives
+  /// the vertical: the frame is then measured about that plane's normal (manhattan_without_floor,
+  /// T_upright_camera placed on that plane); the floor's fields stay unset.
+  Pose T_upright_camera = Pose::Identity();
+  bool manhattan_without_floor = false;
   /// The frame reported is the one held in the world from earlier views, carried by the odometry
   /// (Perception::apply_odometry): this view's own planes made none, or one that the held frame
   /// outweighs; manhattan_why says which.

@@ -72,8 +72,9 @@ int analyze(Context& ctx) {
       std::printf(", \"why\": \"%s\"", json_escape(scene.why).c_str());
     std::printf(", \"manhattan_found\": %s", scene.manhattan_found ? "true" : "false");
     if (scene.manhattan_found)
-      std::printf(", \"manhattan_yaw_deg\": %.3f, \"manhattan_fraction\": %.3f", rad2deg(scene.manhattan_yaw),
-                  scene.manhattan_fraction);
+      std::printf(", \"manhattan_yaw_deg\": %.3f, \"manhattan_fraction\": %.3f, \"manhattan_without_floor\": %s",
+                  rad2deg(scene.manhattan_yaw), scene.manhattan_fraction,
+                  scene.manhattan_without_floor ? "true" : "false");
     else
       std::printf(", \"manhattan_why\": \"%s\"", json_escape(scene.manhattan_why).c_str());
     std::printf(", \"regions\": [");
@@ -100,8 +101,10 @@ int analyze(Context& ctx) {
     else
       std::printf("floor: not found (%s)\n", scene.why.c_str());
     if (scene.manhattan_found)
-      std::printf("manhattan: yaw %.2f deg (%.0f%% of plane area on aligned vertical planes)\n",
-                  rad2deg(scene.manhattan_yaw), 100.f * scene.manhattan_fraction);
+      std::printf("manhattan: yaw %.2f deg (%.0f%% of plane area on aligned vertical planes)%s\n",
+                  rad2deg(scene.manhattan_yaw), 100.f * scene.manhattan_fraction,
+                  scene.manhattan_without_floor ? ", no floor: about the vertical of a floor-like plane refused as the floor"
+                                                : "");
     else
       std::printf("manhattan: not found (%s)\n", scene.manhattan_why.c_str());
     std::printf("%zu regions, %zu obstacle clusters\n", scene.regions.size(), scene.clusters.size());
