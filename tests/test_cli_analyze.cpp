@@ -40,6 +40,19 @@ TEST(CliAnalyze, SyntheticFrameAsTextAndJson) {
     EXPECT_TRUE(has(j.out, key)) << key << " missing in " << j.out.substr(0, 400);
 }
 
+// No floor found (a cold view up a stairwell whose floor strip may be a tread): the Manhattan frame
+// is still measured, about the refused plane's vertical, and both outputs say so.
+TEST(CliAnalyze, ManhattanWithoutAFloorIsSaid) {
+  const CliRun t = run("analyze synth:ascending_short_static:24:20261123 --frame 13");
+  ASSERT_EQ(t.code, 0) << t.out;
+  EXPECT_TRUE(has(t.out, "floor: not found")) << t.out;
+  EXPECT_TRUE(has(t.out, "no floor: about the vertical of a floor-like plane refused as the floor")) << t.out;
+  const CliRun j = run("analyze synth:ascending_short_static:24:20261123 --frame 13 --json");
+  ASSERT_EQ(j.code, 0) << j.out;
+  for (const char* key : {"\"floor_found\": false", "\"manhattan_found\": true", "\"manhattan_without_floor\": true"})
+    EXPECT_TRUE(has(j.out, key)) << key << " missing in " << j.out.substr(0, 400);
+}
+
 TEST(CliAnalyze, PngDrawsTheClassificationInThePapersColours) {
   const std::string png = tmp("ascending.png");
   fs::remove(png);
