@@ -459,6 +459,46 @@ TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
   EXPECT_GE(placed_from_floor, 7);
 }
 
+// Two levels seen cold (nothing remembered, no floor level in view) going down, with an upright
+// face between their heights: the riser faces the user, the step rises away from them, and the
+// one pair's direction (where the levels come nearest the user) followed where the view's border
+// cuts an oblique edge. Held-out seed 1 curb #4, a curb going up seen at 21 deg with the sidewalk
+// filling the view and the street in a corner, was reported as stairs going down. A two-step
+// flight going up, floor out of view, is still reported (the real stair frames are such views).
+TEST(StairsFloorless, TwoLevelsGoingDownWithARiserFacingTheUserAreRefused) {
+  const PipelineConfig cfg = on();
+  Perception perception(cfg);
+  StairStage stage(cfg);
+  SceneResult scene;
+  StairResult r;
+  RgbdFrame frame;
+  FrameTruth truth;
+  synth::render_preset_frame("curb_static", 4, 1u, synth::SynthOptions{}, frame, truth);
+  perception.process(frame, scene);
+  ASSERT_FALSE(scene.floor_found) << "the case is a floor refused by perception";
+  ASSERT_FALSE(truth.stairs.empty());
+  ASSERT_FALSE(truth.stairs.front().goes_down()) << "a curb going up";
+  stage.run(scene, frame.intrinsics, r);
+  EXPECT_EQ(stage.floorless_trace().stacked, 2);
+  EXPECT_EQ(stage.floorless_trace().direction, -1) << "the pair's near distances say down: the test does not test";
+  EXPECT_TRUE(stage.floorless_trace().riser_against);
+  EXPECT_FALSE(r.detected) << to_string(r.kind) << ", " << r.levels << " levels";
+
+  for (int dir : {1, -1}) {
+    SceneBuilder b(1.4f, 45.f, 41);
+    StairSpec s;
+    s.steps = 2;
+    s.direction = dir;
+    s.distance = dir > 0 ? 0.9f : 0.4f;
+    b.add_stairs(s);
+    drop_floor(b.scene);
+    stage.run(b.scene, r);
+    EXPECT_FALSE(stage.floorless_trace().riser_against) << dir;
+    EXPECT_TRUE(r.detected) << dir << ": " << to_string(r.verdict) << ", stacked " << stage.floorless_trace().stacked;
+    EXPECT_EQ(r.kind, dir > 0 ? StairKind::kAscending : StairKind::kDescending) << to_string(r.kind);
+  }
+}
+
 TEST(StairsFloorless, OffByConfig) {
   PipelineConfig cfg;
   cfg.stair_detection.floorless = false;

@@ -12,6 +12,7 @@ namespace {
 constexpr int kMinRegionPixels = 100;   // px, smaller regions have too noisy a normal to vote for up
 constexpr std::size_t kFitPoints = 500; // points per region in the fit of the common normal
 constexpr float kLandingDepth = 0.6f;   // m, a level deeper than this is a landing or a floor
+constexpr float kRiserBandSlack = 0.03f;  // m, a riser's height band may pass its levels' heights by this
 constexpr float kMinRise = 0.05f;       // m, a higher level's near boundary this much farther (nearer)
                                         // than the lower one's says ascending (descending)
 constexpr float kFloorDepthSlack = 0.08f;  // m, a level cut by the image border and seen deeper than
@@ -446,6 +447,22 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
     run_anchored(scene, K, dir, riser, level0, seen, out);
     return;
   }
+  // Two levels seen cold with nothing placing the user's feet: a curb or a single step whose floor
+  // perception refused because it could not tell which of the two the user stands on. The one
+  // pair's direction compares where the levels come nearest the user, and on an edge seen
+  // obliquely that is where the view's border cuts them: a curb going up, seen at 21 deg with the
+  // sidewalk filling the view and the street only in a corner, came out as stairs going down
+  // (held-out seed 1 curb #4). Going down, the face between the two levels turns away from the
+  // user; an upright face seen between their heights says the step rises away from the user, and
+  // a direction the scene contradicts is not reported.
+  if (n == 2 && dir < 0 &&
+      riser_between(scene, nodes_[static_cast<std::size_t>(chain_.back())].height,
+                    nodes_[static_cast<std::size_t>(chain_.front())].height)) {
+    trace_.riser_against = true;
+    out.detected = false;
+    out.verdict = StairVerdict::kNoFloor;  // without it, which way the step goes is not settled
+    return;
+  }
   model(scene, K, dir, 0, level0, out);
   // Cold start: is the first level seen the first step, or the floor the user stands on (seen, but
   // refused by the floor detector: a level camera, a floor strip at the foot of the steps)? The
@@ -493,6 +510,22 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
     return;
   }
   model_on_floor_level(scene, K, dir, out);
+}
+
+bool FloorlessStairs::riser_between(const SceneResult& scene, float h_lo, float h_hi) {
+  const Eigen::Vector3f& up = trace_.up;
+  const float sin_vert = std::sin(cls_.parallel_threshold);
+  for (const PlaneRegion& r : scene.regions) {
+    if (r.points.size() < 40 || std::fabs(r.normal.dot(up)) > sin_vert) continue;
+    const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 300);
+    tmp_.clear();
+    for (std::size_t i = 0; i < r.points.size(); i += stride) tmp_.push_back(up.dot(r.points[i]));
+    std::sort(tmp_.begin(), tmp_.end());
+    // Its height band (10th to 90th percentile) within the pair's, over a third of the riser.
+    const float lo = tmp_[tmp_.size() / 10], hi = tmp_[tmp_.size() * 9 / 10];
+    if (lo >= h_lo - kRiserBandSlack && hi <= h_hi + kRiserBandSlack && hi - lo >= (h_hi - h_lo) / 3.f) return true;
+  }
+  return false;
 }
 
 bool FloorlessStairs::model_on_floor_level(const SceneResult& scene, const CameraIntrinsics* K, int dir,

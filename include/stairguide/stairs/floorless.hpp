@@ -79,7 +79,10 @@
 /// tilt range), a first tread there would put the user's floor outside a chest camera's height
 /// range. It is a step when the camera is outside that range above it. Otherwise nothing says
 /// which, and no staircase is reported (kNoFirstStep) rather than one step off. A first level
-/// whose near boundary is in view is a step.
+/// whose near boundary is in view is a step. Two levels seen cold going down, with an upright face
+/// between their heights (a riser facing the user: the step rises away), are refused
+/// (kNoFloor, trace `riser_against`): their one pair's direction followed where the
+/// view's border cuts an oblique edge.
 ///
 /// Pure: no I/O, no exceptions; buffers are kept between frames.
 
@@ -110,6 +113,9 @@ struct FloorlessTrace {
   /// The stack's top level was the floor around a stairwell (farther than the first tread below it,
   /// a chest camera's height below the camera): taken out of the stack, descending (see the file comment).
   bool floor_beside = false;
+  /// Cold, two levels going down with an upright face between their heights (a riser facing the
+  /// user): the direction is contradicted and nothing is reported.
+  bool riser_against = false;
   int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
   float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
   /// m, anchored: how far the chest had moved towards the flight (first_index risers less
@@ -166,6 +172,9 @@ class FloorlessStairs {
   /// comment); `level0` is the stack's fitted level 0.
   void run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser, float level0,
                     float camera_height, StairResult& out);
+  /// True when an upright region of the input scene stands between heights h_lo < h_hi (up . p,
+  /// camera frame): a riser facing the user.
+  bool riser_between(const SceneResult& scene, float h_lo, float h_hi);
   /// The first stacked level is the user's floor (level 0): models the steps above it, or refuses
   /// (kNoFloor, false) when only one level stands on it (the single-level case needs the floor).
   bool model_on_floor_level(const SceneResult& scene, const CameraIntrinsics* K, int dir, StairResult& out);
