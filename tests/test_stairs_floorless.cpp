@@ -41,6 +41,24 @@ void drop_first_treads(SceneResult& scene, int k) {
   for (int i = 0; i < k && !scene.regions.empty(); ++i) scene.regions.erase(scene.regions.begin());
 }
 
+/// Perception and the stair stage as in use, on one synthetic view at a time taken cold (nothing
+/// remembered from a view before).
+struct ColdRun {
+  PipelineConfig cfg = on();
+  Perception perception{cfg};
+  StairStage stage{cfg};
+  SceneResult scene;
+  StairResult r;
+  RgbdFrame frame;
+  FrameTruth truth;
+  void view(const char* preset, long index, unsigned seed) {
+    synth::render_preset_frame(preset, index, seed, synth::SynthOptions{}, frame, truth);
+    perception.reset();
+    perception.process(frame, scene);
+    stage.run(scene, frame.intrinsics, r);
+  }
+};
+
 struct Tally {
   int frames = 0, detected = 0, wrong_direction = 0, with_tread = 0;
   double riser_abs = 0, riser_max = 0, tread_abs = 0, tread_max = 0;
@@ -394,19 +412,14 @@ float nearest_edge(const StairResult& r, const StairTruth& t, int& k) {
 // Every view of the two approach walks is taken cold; a detection with the distance known must be
 // on the true first edge.
 TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
-  const PipelineConfig cfg = on();
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult r;
-  RgbdFrame frame;
-  FrameTruth truth;
+  ColdRun c;
+  const SceneResult& scene = c.scene;
+  const StairResult& r = c.r;
+  const FrameTruth& truth = c.truth;
+  const StairStage& stage = c.stage;
   const std::pair<const char*, long> views[] = {{"nosing_landing_static", 9}, {"ascending_short_static", 4}};
   for (const auto& [preset, index] : views) {
-    synth::render_preset_frame(preset, index, 5u, synth::SynthOptions{}, frame, truth);
-    perception.reset();
-    perception.process(frame, scene);
-    stage.run(scene, frame.intrinsics, r);
+    c.view(preset, index, 5u);
     const StairFrameEval e = evaluate_stair_frame(r, truth);
     EXPECT_EQ(e.outcome, EvalOutcome::kTP) << preset << " " << index << ": " << to_string(r.verdict);
     // Perception now tells nosing #9's strip from a tread itself (deeper than the treads ahead,
@@ -422,10 +435,7 @@ TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
   int cold = 0, placed = 0, placed_from_floor = 0, unplaced = 0, off_edge = 0, wrong_direction = 0;
   for (const char* walk : {"ascending_approach_climb", "descending_approach_descend"}) {
     for (long i = 0; i <= 240; i += 3) {
-      synth::render_preset_frame(walk, i, 5u, synth::SynthOptions{}, frame, truth);
-      perception.reset();
-      perception.process(frame, scene);
-      stage.run(scene, frame.intrinsics, r);
+      c.view(walk, i, 5u);
       if (scene.floor_found) continue;
       const StairFrameEval e = evaluate_stair_frame(r, truth);
       if (e.outcome == EvalOutcome::kSkipped) continue;  // on the stairs: traversal's
@@ -466,22 +476,16 @@ TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
 // filling the view and the street in a corner, was reported as stairs going down. A two-step
 // flight going up, floor out of view, is still reported (the real stair frames are such views).
 TEST(StairsFloorless, TwoLevelsGoingDownWithARiserFacingTheUserAreRefused) {
-  const PipelineConfig cfg = on();
-  Perception perception(cfg);
-  StairStage stage(cfg);
-  SceneResult scene;
-  StairResult r;
-  RgbdFrame frame;
-  FrameTruth truth;
-  synth::render_preset_frame("curb_static", 4, 1u, synth::SynthOptions{}, frame, truth);
-  perception.process(frame, scene);
-  ASSERT_FALSE(scene.floor_found) << "the case is a floor refused by perception";
-  ASSERT_FALSE(truth.stairs.empty());
-  ASSERT_FALSE(truth.stairs.front().goes_down()) << "a curb going up";
-  stage.run(scene, frame.intrinsics, r);
-  EXPECT_EQ(stage.floorless_trace().stacked, 2);
-  EXPECT_EQ(stage.floorless_trace().direction, -1) << "the pair's near distances say down: the test does not test";
-  EXPECT_TRUE(stage.floorless_trace().riser_against);
+  ColdRun c;
+  const StairResult& r = c.r;
+  const FloorlessTrace& trace = c.stage.floorless_trace();
+  c.view("curb_static", 4, 1u);
+  ASSERT_FALSE(c.scene.floor_found) << "the case is a floor refused by perception";
+  ASSERT_FALSE(c.truth.stairs.empty());
+  ASSERT_FALSE(c.truth.stairs.front().goes_down()) << "a curb going up";
+  EXPECT_EQ(trace.stacked, 2);
+  EXPECT_EQ(trace.direction, -1) << "the pair's near distances say down: the test does not test";
+  EXPECT_TRUE(trace.riser_against);
   EXPECT_FALSE(r.detected) << to_string(r.kind) << ", " << r.levels << " levels";
 
   for (int dir : {1, -1}) {
@@ -492,9 +496,9 @@ TEST(StairsFloorless, TwoLevelsGoingDownWithARiserFacingTheUserAreRefused) {
     s.distance = dir > 0 ? 0.9f : 0.4f;
     b.add_stairs(s);
     drop_floor(b.scene);
-    stage.run(b.scene, r);
-    EXPECT_FALSE(stage.floorless_trace().riser_against) << dir;
-    EXPECT_TRUE(r.detected) << dir << ": " << to_string(r.verdict) << ", stacked " << stage.floorless_trace().stacked;
+    c.stage.run(b.scene, c.r);
+    EXPECT_FALSE(trace.riser_against) << dir;
+    EXPECT_TRUE(r.detected) << dir << ": " << to_string(r.verdict) << ", stacked " << trace.stacked;
     EXPECT_EQ(r.kind, dir > 0 ? StairKind::kAscending : StairKind::kDescending) << to_string(r.kind);
   }
 }
