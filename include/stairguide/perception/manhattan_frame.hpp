@@ -78,7 +78,9 @@ class ManhattanTracker {
   /// alone (they still vote). 0: no such test.
   explicit ManhattanTracker(const ManhattanConfig& config = {}, float max_range = 0.f);
 
-  /// Estimates the Manhattan frame from the vertical planes among `regions`, given the floor.
+  /// Estimates the Manhattan frame from the vertical planes among `regions`, given the floor
+  /// (`T_floor_camera`; without a floor, the upright frame of a floor-like plane the floor's checks
+  /// refused: SceneResult::T_upright_camera).
   /// `compass`, when given, is asked (once, only when the planes alone make no trusted frame) for
   /// the image edges' direction (edge_compass.hpp): agreeing planes too narrow or too small to be
   /// trusted alone then make the frame (ManhattanConfig::compass_*).
