@@ -160,6 +160,31 @@ TEST(PerceptionFloor, TheFirstTreadWithTheFloorOutOfViewIsRefused) {
   EXPECT_GE(refused, 1);
 }
 
+// Cold view up a flight between the walls of a stairwell (held-out seed 19), the floor out of
+// view: the first tread fills the bottom of the view, 0.30 m deep like the treads ahead and as
+// wide as the flight. Only 85% of its pixels have the next tread above them in the image (the rest
+// lie under the stairwell's side wall), so the column test let it through and it was taken for
+// the floor (1.398 m for 1.567 m: the flight counted a step short). In 3D it has a tread's shape.
+TEST(PerceptionFloor, TheFirstTreadInAStairwellIsNoFloor) {
+  FrameTruth truth;
+  const SceneResult scene = cold_view("ascending_short_static", 13, 19u, truth);
+  ASSERT_FALSE(truth.stairs.empty()) << "the world changed";
+  if (scene.floor_found) {
+    EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f)
+        << "a tread taken for the floor (floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
+        << " m)";
+  }
+}
+
+// What that protection leaves alone (held-out seeds): the floor in front of a flight that fills a
+// stairwell wall to wall is as wide as the flight too, but seen deeper than its treads (0.45 to
+// 0.60 m against 0.29 to 0.32 m), so it is no tread and stays the floor.
+TEST(PerceptionFloor, TheFloorOfAStairwellDeeperThanATreadIsKept) {
+  expect_floor_found("ascending_short_static", 3, "wall to wall, 0.60 m deep", 13u);
+  expect_floor_found("ascending_short_static", 8, "wall to wall, 0.45 m deep", 5u);
+  expect_floor_found("ascending_short_static", 5, "wall to wall, 0.55 m deep", 20u);
+}
+
 // Cold view of a curb from its upper level (held-out seed 2): the user's level shows only as a
 // strip cut by the view's bottom-left corner (0.165 m above the road, too small for a floor), and
 // the road was taken for the floor (1.44 m instead of 1.275 m: the curb ahead turned upside down).

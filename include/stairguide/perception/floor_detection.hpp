@@ -104,6 +104,9 @@ class FloorDetector {
   // C (at the view's edge) cannot be a tread of the flight whose next tread is A, one riser above
   // it: C's level goes on beyond A's riser line beside the flight, or C is deeper than the treads.
   bool not_a_tread_of(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A);
+  // C's level lies within the width of the flight whose tread A is (one riser from C) and C is
+  // no deeper than A: C may be a tread of that flight, whatever the image columns say.
+  bool tread_shaped(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A);
   // A bigger level one riser above candidate c and another one riser below it ahead, within its
   // width: c is a tread of a descent (its top seen cold), not the floor.
   bool middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near);
