@@ -197,6 +197,18 @@ TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
   EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
 }
 
+// The same from near the view's corner (held-out seed 20): the user's level shows as a triangle
+// cut by the view's left and bottom borders, and its edge with the road runs 0.54 m between them,
+// short of the 0.8 m asked of a curb's edge; the road was taken for the floor (1.499 m for
+// 1.365 m). An edge cut by the view at both ends is as long as it is seen or longer: no floor.
+TEST(PerceptionFloor, UserOnTheLevelAboveSeenInTheViewsCornerIsNoFloor) {
+  FrameTruth truth;
+  const SceneResult scene = cold_view("curb_static", 1, 20u, truth);
+  EXPECT_FALSE(scene.floor_found) << "floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
+                                  << " m";
+  EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
+}
+
 // The protection does not reach a step beside the floor (held-out seed 3): a single step cut by
 // the view's bottom edge, 0.166 m above the floor, with a straight 1.2 m edge, but the nadir lies
 // on the floor's side of that edge (about 1 m): the user stands on the floor, which is found.

@@ -149,6 +149,7 @@ struct FloorConfig {
   float curb_boundary_gap = 0.25f;  ///< m, points of that level this near the candidate form their boundary
   float curb_straightness = 0.04f;  ///< m, largest rms off a straight line for that boundary
   float curb_min_edge = 0.8f;       ///< m, shortest such boundary (a curb's edge, not a crate's corner)
+  float curb_min_edge_cut = 0.4f;   ///< m, ... or this, when the view's border cuts it at both ends
   int verify_min_pixels = 400;    ///< px, this many pixels below and nearer reject a floor candidate
   int verify_stride_px = 6;       ///< px, sampling grid of the frame for the check
 
@@ -210,6 +211,8 @@ struct FloorConfig {
           "points of that level this near the candidate (in the floor plane) form their boundary");
     v.num(curb_min_edge, "curb_min_edge_m", Unit::kMetre, 0, 10,
           "that boundary is a curb's edge (not the corner of a platform or a crate) when at least this long");
+    v.num(curb_min_edge_cut, "curb_min_edge_cut_m", Unit::kMetre, 0, 10,
+          "... or at least this long when the view's border cuts it at both ends (its length unknown)");
     v.num(curb_straightness, "curb_straightness_cm", Unit::kCentimetre, 0.1, 50,
           "that boundary is a straight edge (a curb) when its rms off a line is at most this");
     v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,

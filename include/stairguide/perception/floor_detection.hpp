@@ -114,6 +114,10 @@ class FloorDetector {
   // straight boundary with c (measured in c's floor frame), extended, leaves the user's nadir on
   // its side: the user may stand on that level, seen only at the view's edge.
   bool level_above_underfoot(const std::vector<PlaneRegion>& regions, int c, int width, int height);
+  // The point of `edge` (floor frame x, z; `rise` above the frame's plane) nearest position t
+  // along `along` lies at the view's border or beyond it.
+  bool edge_end_at_border(const std::vector<Eigen::Vector2f>& edge, const Eigen::Vector2f& along, float t,
+                          const Pose& T_floor_camera, float rise, int width, int height) const;
   std::vector<unsigned char> grid_;
   std::vector<unsigned char> curb_grid_;                 // level_above_underfoot scratch: the grid grown along x
   std::vector<Eigen::Vector2f> curb_u_, curb_edge_;      // ... the upper level's points and its edge with F (floor frame x, z)
