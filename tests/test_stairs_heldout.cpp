@@ -187,3 +187,29 @@ TEST(StairsHeldout, FloorAroundTheStairwellIsNoStep) {
   EXPECT_NE(r.kind, StairKind::kDescending) << to_string(r.verdict) << ", " << r.levels << " levels";
   EXPECT_FALSE(p.stage.floorless_trace().floor_beside);
 }
+
+// An open shelf seen cold from 1.7 m (held-out seed 18): its bottom board (1.07 m long, 13 cm up),
+// a box on it and a piece of the next board, 12.6 cm apart, were reported as a flight of 3 going
+// up, 33.7 cm treads. Going up, a tread is never seen beyond the far side of the tread above it;
+// the board runs on 0.6 m past the box on it: the box stands on the board.
+TEST(StairsHeldout, BoxOnAShelfBoardIsNoFlight) {
+  StairResult r;
+  FrameTruth truth;
+  run_view("shelves_static", 22, 18u, r, truth);
+  EXPECT_FALSE(r.detected) << to_string(r.kind) << ", " << r.levels << " levels";
+  EXPECT_EQ(r.verdict, StairVerdict::kStackedLevels) << to_string(r.verdict);
+}
+
+// What that leaves alone, from the views that a first, looser form of the rule lost: a region at
+// the fourth level's height in front of the third tread (seed 12 rotated #12), a landing reaching
+// back beside the flight (seed 1 rotated #16), a tread seen 12 cm past the next one's near edge
+// (seed 11 ascending #13, its top tread cut by the view).
+TEST(StairsHeldout, TreadsBesideOrUnderNoLevelAreKept) {
+  expect_ascending("rotated_static", 1, 16);
+  expect_ascending("rotated_static", 12, 12);
+  StairResult r;
+  FrameTruth truth;
+  run_view("ascending_static", 13, 11u, r, truth);
+  EXPECT_TRUE(r.detected) << to_string(r.verdict);
+  EXPECT_EQ(evaluate_stair_frame(r, truth).outcome, EvalOutcome::kTP);
+}

@@ -629,6 +629,10 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
       landing_[static_cast<std::size_t>(k)] = 1;
     if (!landing_[static_cast<std::size_t>(k)]) ++steps_not_landing;
   }
+  if (dir > 0 && level_stands_on_lower(n, x2, z2, out)) {
+    out.verdict = StairVerdict::kStackedLevels;
+    return;
+  }
   float a_min = std::numeric_limits<float>::max(), a_max = -a_min;
   for (int k = 1; k <= n; ++k) {
     if (steps_not_landing > 0 && landing_[static_cast<std::size_t>(k)]) continue;
@@ -1139,6 +1143,31 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     out.verdict = StairVerdict::kDetected;
     out.detected = true;
   }
+}
+
+bool StairModelling::level_stands_on_lower(int n, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
+                                           const StairResult& out) const {
+  // Going up a flight, each tread starts where the one below it ends, at its riser: a lower tread
+  // is never seen beyond the far side of the tread above it (it would lie under the treads
+  // above). A level that does show beyond the far side of the next one up, within that one's
+  // width, carries it: a box on a shelf board, a crate on a platform, not a flight (held-out seed
+  // 18's shelves #22: an open shelf's bottom board, a box on it and a piece of the board above,
+  // 12.6 cm apart, were reported as stairs going up). Only a next level starting beyond this
+  // one's start, and not a landing, is asked: a landing or an odd region beside the flight (a
+  // wall's cap) may lie anywhere.
+  constexpr float kBeyond = 0.10f;  // m, beyond the far side by more than a nosing and the noise
+  for (int k = 1; k < n; ++k) {
+    const StairLevel& lo = out.level_data[static_cast<std::size_t>(k)];
+    const StairLevel& hi = out.level_data[static_cast<std::size_t>(k + 1)];
+    if (landing_[static_cast<std::size_t>(k + 1)] || !(hi.depth_min > lo.depth_min + 0.05f)) continue;
+    std::size_t beyond = 0;
+    for (const auto& p : levels_[static_cast<std::size_t>(k)].pts) {
+      const float a = x2.dot(p);
+      beyond += z2.dot(p) > hi.depth_max + kBeyond && a >= hi.lateral_min && a <= hi.lateral_max;
+    }
+    if (beyond >= std::max<std::size_t>(30, levels_[static_cast<std::size_t>(k + 1)].pts.size() / 4)) return true;
+  }
+  return false;
 }
 
 }  // namespace stairguide

@@ -27,6 +27,7 @@ const char* to_string(StairVerdict v) {
     case StairVerdict::kBlondelOutOfRange: return "2R+T outside the building code";
     case StairVerdict::kTooNarrow: return "narrower than the narrowest staircase";
     case StairVerdict::kInconsistentEdges: return "step edges not evenly spaced";
+    case StairVerdict::kStackedLevels: return "a level stands on the one below it (an object on a surface)";
   }
   return "unknown";
 }

@@ -92,6 +92,10 @@ class StairModelling {
   /// ends over its depth (a shelf's or cabinet's bottom board). Axes and positions as in validation.
   bool boxed_in(const SceneResult& scene, const Eigen::Vector3f& xs, const Eigen::Vector3f& up,
                 const Eigen::Vector3f& zs, float a_mid, float edge_b, const StairLevel& o, float plane) const;
+  /// Going up (levels 1..n in the basis x2, z2, their extents in out.level_data): true when a level
+  /// shows well beyond the far side of the next one up, within its width: it carries that level
+  /// (a box on a shelf board), no flight does.
+  bool level_stands_on_lower(int n, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2, const StairResult& out) const;
   /// Turns z2 so that the near boundary of a single level runs along x.
   void refine_single_axis(const Level2d& level, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
                           const Eigen::Vector3f& e2, const Eigen::Vector3f& up);

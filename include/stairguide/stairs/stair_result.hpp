@@ -36,7 +36,8 @@ enum class StairVerdict {
   kTreadTooShort,     ///< tread shorter than the building code allows (e.g. shelves)
   kBlondelOutOfRange, ///< 2R + T outside the building code
   kTooNarrow,         ///< narrower than the narrowest staircase
-  kInconsistentEdges  ///< step edges not evenly spaced (not a staircase)
+  kInconsistentEdges, ///< step edges not evenly spaced (not a staircase)
+  kStackedLevels      ///< a level stands on the one below it (a box on a shelf board), not a step
 };
 /// Short human-readable reason ("no floor", "tread too short", ...).
 const char* to_string(StairVerdict v);
