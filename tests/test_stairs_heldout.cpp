@@ -213,3 +213,16 @@ TEST(StairsHeldout, TreadsBesideOrUnderNoLevelAreKept) {
   EXPECT_TRUE(r.detected) << to_string(r.verdict);
   EXPECT_EQ(evaluate_stair_frame(r, truth).outcome, EvalOutcome::kTP);
 }
+
+// A curb seen from the street at a slant (held-out seed 18): the sidewalk fills the view, its
+// near boundary is the curb's edge for 24 lateral bins and a far outline at a slant for 30. The
+// median of all bins put the edge 34 cm into the sidewalk and the curb was reported there; the
+// largest group of bins at one depth is the edge. It must never be reported off its edge.
+TEST(StairsHeldout, CurbAtASlantIsPlacedOnItsEdgeOrNotAtAll) {
+  StairResult r;
+  FrameTruth truth;
+  run_view("curb_static", 7, 18u, r, truth);
+  if (r.detected) {
+    EXPECT_EQ(evaluate_stair_frame(r, truth).outcome, EvalOutcome::kTP) << "reported off the curb's edge";
+  }
+}

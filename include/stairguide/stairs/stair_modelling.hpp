@@ -84,6 +84,9 @@ class StairModelling {
   float boundary_median_ab(const std::vector<float>& a, const std::vector<float>& b, bool low, const BoundaryFrame& f);
   float boundary_median(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
                         const BoundaryFrame& f);
+  /// The near boundary from the bins of the last boundary_median: the median of the largest group
+  /// of bins at one depth (the edge), or `median` when fewer than 5 agree.
+  float boundary_mode(float median);
   /// True when the far side of a level (points in the basis x2, z2) lies mostly on the image
   /// border: its far boundary is where the view ends. False without the intrinsics.
   bool far_side_cut(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2,
