@@ -189,24 +189,22 @@ TEST(PerceptionFloor, TheFloorOfAStairwellDeeperThanATreadIsKept) {
 // strip cut by the view's bottom-left corner (0.165 m above the road, too small for a floor), and
 // the road was taken for the floor (1.44 m instead of 1.275 m: the curb ahead turned upside down).
 // The strip's straight edge with the road leaves the nadir on the strip's side: no floor.
-TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
+void expect_user_on_level_above(const char* preset, long index, std::uint32_t seed) {
   FrameTruth truth;
-  const SceneResult scene = cold_view("curb_static", 4, 2u, truth);
-  EXPECT_FALSE(scene.floor_found) << "floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
-                                  << " m";
+  const SceneResult scene = cold_view(preset, index, seed, truth);
+  EXPECT_FALSE(scene.floor_found) << preset << " " << index << ": floor at " << scene.camera_height << " m, truth "
+                                  << truth.camera_height_m << " m";
   EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
 }
+
+TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) { expect_user_on_level_above("curb_static", 4, 2u); }
 
 // The same from near the view's corner (held-out seed 20): the user's level shows as a triangle
 // cut by the view's left and bottom borders, and its edge with the road runs 0.54 m between them,
 // short of the 0.8 m asked of a curb's edge; the road was taken for the floor (1.499 m for
 // 1.365 m). An edge cut by the view at both ends is as long as it is seen or longer: no floor.
 TEST(PerceptionFloor, UserOnTheLevelAboveSeenInTheViewsCornerIsNoFloor) {
-  FrameTruth truth;
-  const SceneResult scene = cold_view("curb_static", 1, 20u, truth);
-  EXPECT_FALSE(scene.floor_found) << "floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
-                                  << " m";
-  EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
+  expect_user_on_level_above("curb_static", 1, 20u);
 }
 
 // The protection does not reach a step beside the floor (held-out seed 3): a single step cut by
