@@ -18,6 +18,13 @@ struct View {
   float yaw_err = -1.f;  // degrees; < 0: no frame
 };
 
+// One view of the held-out sweep: preset, view index, seed.
+struct Case {
+  const char* preset;
+  long index;
+  std::uint32_t seed;
+};
+
 View run_view(const std::string& preset, long index, std::uint32_t seed, const ManhattanConfig& manhattan = {}) {
   View v;
   RgbdFrame frame;
@@ -75,11 +82,7 @@ TEST(ManhattanFrame, StripsOfOnePlaneMakeAFrame) {
 // 0.014 to 0.016 m^2 in view: half of it beyond the furniture's plane vetoes the furniture's frame
 // (14 degrees off before).
 TEST(ManhattanFrame, SmallWallBeyondFurnitureVetoesItsFrame) {
-  const struct {
-    const char* preset;
-    long index;
-    std::uint32_t seed;
-  } views[] = {{"sofa_static", 6, 12}, {"shelves_static", 19, 11}};
+  const Case views[] = {{"sofa_static", 6, 12}, {"shelves_static", 19, 11}};
   for (const auto& c : views) {
     const View v = run_view(c.preset, c.index, c.seed);
     EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f)
@@ -91,11 +94,7 @@ TEST(ManhattanFrame, SmallWallBeyondFurnitureVetoesItsFrame) {
 // own (ManhattanConfig::min_plane_width), gives the frame: the furniture's frame is wrong, the
 // room's is in view (before: a sofa's or shelves' frame vetoed, and no frame at all).
 TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
-  const struct {
-    const char* preset;
-    long index;
-    std::uint32_t seed;
-  } views[] = {{"sofa_static", 23, kSuiteSeed}, {"sofa_static", 13, 1}, {"shelves_static", 13, 3}};
+  const Case views[] = {{"sofa_static", 23, kSuiteSeed}, {"sofa_static", 13, 1}, {"shelves_static", 13, 3}};
   for (const auto& c : views) {
     const View v = run_view(c.preset, c.index, c.seed);
     ASSERT_GE(v.truth.wall_or_riser_pixels, 1000) << c.preset << " #" << c.index << " seed " << c.seed;
@@ -121,11 +120,7 @@ TEST(ManhattanFrame, NarrowWallOnTheFloorGivesTheFrame) {
 // up to a turn about that sloping axis, which turns its yaw. It made frames 4.4-5.5 deg off with
 // the staircase in view; it makes none now.
 TEST(ManhattanFrame, SlopedHandrailMakesNoFrame) {
-  const struct {
-    const char* preset;
-    long index;
-    std::uint32_t seed;
-  } views[] = {{"descending_static", 16, 1}, {"descending_static", 7, 7}, {"descending_static", 20, 11},
+  const Case views[] = {{"descending_static", 16, 1}, {"descending_static", 7, 7}, {"descending_static", 20, 11},
                {"people_static", 6, 9}};
   for (const auto& c : views) {
     const View v = run_view(c.preset, c.index, c.seed);
@@ -318,11 +313,7 @@ TEST(ManhattanFrame, RiserCornerAtTheImageEdgeGivesTheFrame) {
 // seeds, all now within 0.61 deg). ascending_short #13 looks up a stairwell; nosing_landing #0
 // seed 10 at a flight's foot; people #15 seed 1 past people at the foot of one.
 TEST(ManhattanFrame, FloorRefusedStillGivesTheVertical) {
-  const struct {
-    const char* preset;
-    long index;
-    std::uint32_t seed;
-  } views[] = {{"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 15, 1}};
+  const Case views[] = {{"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 15, 1}};
   ManhattanConfig off;
   off.without_floor = false;
   for (const auto& c : views) {
