@@ -53,6 +53,12 @@ Pose manhattan_pose_from_yaw(float yaw);
 /// The representative of a direction modulo 90 degrees, in (-pi/4, pi/4].
 float manhattan_wrap(float a);
 
+/// The unit normal of the plane through `pts` (camera frame) held orthogonal to `up` (unit, camera
+/// frame): a wall's, fitted as upright. On the side of `n0` (the plane's free fit, also returned
+/// when the points fix no upright plane). See manhattan_frame.cpp for why and where it is used.
+Eigen::Vector3f fit_upright_normal(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& up,
+                                   const Eigen::Vector3f& n0);
+
 /// k_M is the dominant direction closest to forward; near +-45 degrees both branches are about as
 /// close, so `yaw` is moved onto the branch of the `previous` k_M where that stays within 10
 /// degrees of 45 (hysteresis).
