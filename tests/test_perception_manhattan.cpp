@@ -35,6 +35,15 @@ View run_view(const std::string& preset, long index, std::uint32_t seed, const M
   return v;
 }
 
+// The view shows at least `min_wall_px` of wall or riser and gets a frame within 2 degrees.
+void expect_frame_within_2deg(const Case& c, int min_wall_px) {
+  const View v = run_view(c.preset, c.index, c.seed);
+  const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+  ASSERT_GE(v.truth.wall_or_riser_pixels, min_wall_px) << name;
+  EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
+  EXPECT_LE(v.yaw_err, 2.f) << name;
+}
+
 }  // namespace
 
 constexpr std::uint32_t kSuiteSeed = 20261123u;  // test_perception's default seed
@@ -66,16 +75,8 @@ TEST(ManhattanFrame, PlanesParallelOnlyToDegreesMakeNoPair) {
 // Narrow strips of one riser (0.13 and 0.15 m, 1.1 m apart on one line) and of one wall (0.13 and
 // 0.12 m, 1.4 m apart) were refused as too narrow: together they are as wide as they span.
 TEST(ManhattanFrame, StripsOfOnePlaneMakeAFrame) {
-  const struct {
-    const char* preset;
-    long index;
-  } views[] = {{"ascending_static", 17}, {"people_static", 17}};
-  for (const auto& c : views) {
-    const View v = run_view(c.preset, c.index, kSuiteSeed);
-    ASSERT_GE(v.truth.wall_or_riser_pixels, 1000) << c.preset << " #" << c.index;
-    EXPECT_GE(v.yaw_err, 0.f) << c.preset << " #" << c.index << ": no frame (" << v.sc.manhattan_why << ")";
-    EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index;
-  }
+  for (const Case& c : {Case{"ascending_static", 17, kSuiteSeed}, Case{"people_static", 17, kSuiteSeed}})
+    expect_frame_within_2deg(c, 1000);
 }
 
 // A strip of wall 0.23 to 0.29 m wide seen past shelves or a sofa turned against the room has only
@@ -95,13 +96,7 @@ TEST(ManhattanFrame, SmallWallBeyondFurnitureVetoesItsFrame) {
 // room's is in view (before: a sofa's or shelves' frame vetoed, and no frame at all).
 TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
   const Case views[] = {{"sofa_static", 23, kSuiteSeed}, {"sofa_static", 13, 1}, {"shelves_static", 13, 3}};
-  for (const auto& c : views) {
-    const View v = run_view(c.preset, c.index, c.seed);
-    ASSERT_GE(v.truth.wall_or_riser_pixels, 1000) << c.preset << " #" << c.index << " seed " << c.seed;
-    EXPECT_GE(v.yaw_err, 0.f) << c.preset << " #" << c.index << " seed " << c.seed << ": no frame ("
-                              << v.sc.manhattan_why << ")";
-    EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index << " seed " << c.seed;
-  }
+  for (const Case& c : views) expect_frame_within_2deg(c, 1000);
 }
 
 // A wall seen mostly at the depth cut-off, a band a few decimetres tall, fixes its tilt poorly, and
@@ -111,13 +106,7 @@ TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
 TEST(ManhattanFrame, WallAtTheDepthCutOffIsHeldUpright) {
   const Case views[] = {{"descending_static", 14, 4}, {"descending_static", 6, 18}, {"floor_only_static", 9, 1},
                         {"shelves_static", 6, 1},     {"people_static", 12, 10},    {"table_static", 14, 17}};
-  for (const auto& c : views) {
-    const View v = run_view(c.preset, c.index, c.seed);
-    ASSERT_GE(v.truth.wall_or_riser_pixels, 200) << c.preset << " #" << c.index << " seed " << c.seed;
-    EXPECT_GE(v.yaw_err, 0.f) << c.preset << " #" << c.index << " seed " << c.seed << ": no frame ("
-                              << v.sc.manhattan_why << ")";
-    EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index << " seed " << c.seed;
-  }
+  for (const Case& c : views) expect_frame_within_2deg(c, 200);
 }
 
 // A wall standing on the floor with no floor beyond it, 0.29 m wide between shelves turned 17 deg
@@ -125,10 +114,7 @@ TEST(ManhattanFrame, WallAtTheDepthCutOffIsHeldUpright) {
 // that may veto a frame) it gives the room's frame (before, at 0.3 m: it only vetoed the
 // shelves' frame, and there was none).
 TEST(ManhattanFrame, NarrowWallOnTheFloorGivesTheFrame) {
-  const View v = run_view("shelves_static", 18, kSuiteSeed);
-  ASSERT_GE(v.truth.wall_or_riser_pixels, 500);
-  EXPECT_GE(v.yaw_err, 0.f) << "shelves_static #18: no frame (" << v.sc.manhattan_why << ")";
-  EXPECT_LE(v.yaw_err, 2.f) << "shelves_static #18";
+  expect_frame_within_2deg({"shelves_static", 18, kSuiteSeed}, 500);
 }
 
 // A handrail beside an open-sided descent, seen against the floor below, comes out as a vertical
