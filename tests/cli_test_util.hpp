@@ -1,5 +1,5 @@
 #pragma once
-// Runs the stairguide binary for CLI tests: exit code and stdout + stderr together.
+// Runs the stairguide binary (or a shell command) for CLI tests: exit code and stdout + stderr together.
 #include <sys/wait.h>
 
 #include <array>
@@ -13,9 +13,10 @@ struct CliRun {
   std::string out;  // stdout and stderr together
 };
 
-inline CliRun run(const std::string& args) {
+/// A shell command line: its exit code and its stdout + stderr together.
+inline CliRun run_shell(const std::string& command) {
   CliRun r;
-  const std::string cmd = std::string(STAIRGUIDE_CLI) + " " + args + " 2>&1";
+  const std::string cmd = command + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
   std::array<char, 4096> buf{};
@@ -25,6 +26,8 @@ inline CliRun run(const std::string& args) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+inline CliRun run(const std::string& args) { return run_shell(std::string(STAIRGUIDE_CLI) + " " + args); }
 
 /// A scratch path in the build folder, unique to the test binary's `prefix`.
 inline std::string tmp(const std::string& prefix, const std::string& name) {
