@@ -72,6 +72,12 @@ TEST(FreshMachine, RefusesADirectoryItDidNotMake) {
   const cli_test::CliRun r = fresh_machine(s.dir.string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("was not made by this script"), std::string::npos) << r.out;
+  // Nor a file in its place.
+  const fs::path file = s.dir / "keep.txt";
+  std::ofstream(file) << "someone's file\n";
+  const cli_test::CliRun f = fresh_machine(file.string());
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("is not a directory"), std::string::npos) << f.out;
   // With the tool's marker it is one of its roots.
   std::ofstream(s.dir / ".stairguide-fresh").flush();
   EXPECT_EQ(fresh_machine(s.dir.string()).code, 0);
