@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
 #include <string>
 
 #include "stairguide/capture/synthetic.hpp"
@@ -332,4 +335,74 @@ TEST(ManhattanFrame, FloorRefusedStillGivesTheVertical) {
     EXPECT_FALSE(w.sc.manhattan_found) << c.preset << " #" << c.index << " seed " << c.seed;
     EXPECT_EQ(w.sc.manhattan_why, "no floor");
   }
+}
+
+// A far wall reaching the depth cut-off (5 m): the cut-off keeps a reading only when its noise fell
+// short of it, so the readings of the wall's far part are the ones pushed nearer, and its plane
+// held upright turns towards the camera there. Fitted again on the readings whose plane lies
+// 3 sigma clear of the cut-off (chosen by ray, which the noise does not move), the yaw is right.
+// Kinect-like noise: a constant sigma in 1/z (sigma_z = 1.425e-3 z^2), over 40 draws.
+TEST(ManhattanFrame, WallReachingTheCutOffIsFittedClearOfIt) {
+  const float f = 570.f, cx = 320.f, cy = 240.f, cut = 5.f, coeff = 1.425e-3f;
+  const float clear = cut - 3.f * coeff * cut * cut;
+  const Eigen::Vector3f up(0.f, -1.f, 0.f);  // a level camera: y down
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.f, coeff);
+  double err_upright = 0, err_clear = 0;
+  int refitted = 0;
+  const int draws = 40;
+  for (int k = 0; k < draws; ++k) {
+    // An upright wall turned 35-55 deg from the optical axis, 0.5 m of it from 4.55 to 5.3 m away.
+    const float yaw = (35.f + 20.f * static_cast<float>(k) / draws) * static_cast<float>(M_PI) / 180.f;
+    const Eigen::Vector3f n(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
+    const Eigen::Vector3f p0(0.f, 0.f, 4.8f);
+    const float D = n.dot(p0);
+    std::vector<Eigen::Vector3f> pts;
+    for (int v = 300; v < 360; v += 2)
+      for (int u = 0; u < 640; u += 2) {
+        const Eigen::Vector3f ray((u - cx) / f, (v - cy) / f, 1.f);
+        const float z = D / n.dot(ray);  // the wall's depth along the ray
+        if (!(z > 4.55f && z < 5.3f)) continue;
+        const float zm = 1.f / (1.f / z + noise(rng));
+        if (zm > cut) continue;  // the cut-off drops it
+        pts.push_back(zm * ray);
+      }
+    ASSERT_GT(pts.size(), 500u);
+    const Eigen::Vector3f nu = fit_upright_normal(pts, up, n);
+    const Eigen::Vector3f nc = fit_upright_normal_clear_of_cutoff(pts, up, nu, clear);
+    refitted += !nc.isApprox(nu);
+    auto off_deg = [&](const Eigen::Vector3f& m) { return std::acos(std::min(1.f, m.dot(n))) * 180.0 / M_PI; };
+    err_upright += off_deg(nu);
+    err_clear += off_deg(nc);
+  }
+  err_upright /= draws;
+  err_clear /= draws;
+  std::printf("wall reaching the cut-off: mean yaw error %.2f deg held upright, %.2f fitted clear of it\n", err_upright,
+              err_clear);
+  EXPECT_EQ(refitted, draws);
+  // Measured: 0.92 deg held upright, 0.28 clear of the cut-off (the noise of the fewer readings).
+  EXPECT_GT(err_upright, 0.7) << "the cut-off no longer biases the fit: the test does not test";
+  EXPECT_LT(err_clear, 0.4);
+  EXPECT_LT(err_clear, 0.5 * err_upright);
+}
+
+// A wall seen mostly clear of the cut-off noise band keeps its readings' fit; one seen mostly
+// inside it keeps its upright fit (its clear part is too narrow to fix a yaw).
+TEST(ManhattanFrame, WallInsideTheCutOffBandKeepsItsUprightFit) {
+  const Eigen::Vector3f up(0.f, -1.f, 0.f), n(0.f, 0.f, -1.f);
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < 100; ++i) pts.emplace_back(0.01f * static_cast<float>(i) - 0.5f, 0.f, 4.95f);
+  const Eigen::Vector3f turned = Eigen::Vector3f(0.05f, 0.f, -1.f).normalized();
+  EXPECT_TRUE(fit_upright_normal_clear_of_cutoff(pts, up, turned, 4.89f).isApprox(turned));
+  EXPECT_TRUE(fit_upright_normal_clear_of_cutoff(pts, up, turned, 0.f).isApprox(turned));
+  // Clear of the band, the points' own plane (facing the camera) is fitted.
+  EXPECT_LT((fit_upright_normal_clear_of_cutoff(pts, up, turned, 5.5f) - n).norm(), 1e-4f);
+}
+
+// Far walls fitted clear of the cut-off's noise band: the suite's sofa #0 (its far wall, 0.74 m
+// wide at 4.92 m, had let the sofa's frame stand 2.01 deg off) and seed 16's people #1 (2.18 deg
+// off with a staircase in view, the one such frame on seeds 1-20) come within 2 deg.
+TEST(ManhattanFrame, FarWallsFittedClearOfTheCutOff) {
+  const Case views[] = {{"sofa_static", 0, kSuiteSeed}, {"people_static", 1, 16}};
+  for (const Case& c : views) expect_frame_within_2deg(c, 500);
 }

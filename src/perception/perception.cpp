@@ -25,13 +25,13 @@ const char* to_string(RegionClass c) {
 
 Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor, const ManhattanConfig& manhattan,
                        const ClassificationConfig& classification)
-    : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range),
+    : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range, seg.depth_noise_coeff),
       classification_(classification), manhattan_cfg_(manhattan) {}
 
 Perception::Perception(const PipelineConfig& c)
     : Perception(c.segmentation, c.floor, c.manhattan, c.classification) {
   // Vertical planes seen at the depth cut-off give the Manhattan frame no direction.
-  manhattan_ = ManhattanTracker(c.manhattan, c.capture.max_range);
+  manhattan_ = ManhattanTracker(c.manhattan, c.capture.max_range, c.segmentation.depth_noise_coeff);
 }
 
 void Perception::reset() {

@@ -11,7 +11,9 @@
 /// in view make none.
 /// Planes with floor beyond them (furniture, risers, people: they stand inside the room) vote only
 /// when the others (walls, which bound the floor) make no frame; a wall standing on the floor is
-/// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame.
+/// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame;
+/// their yaw is their plane's held upright, fitted on their readings clear of the cut-off's noise
+/// band when at least half of them are (fit_upright_normal_clear_of_cutoff).
 /// A wall (no surface at all beyond it, standing on the floor or reaching the cut-off, at least
 /// veto_min_width wide) seen beyond a plane that makes the frame (structure_beyond_area of it, or
 /// half of a smaller one) and disagreeing with the frame modulo 90 degrees vetoes it: no frame
@@ -59,6 +61,15 @@ float manhattan_wrap(float a);
 Eigen::Vector3f fit_upright_normal(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& up,
                                    const Eigen::Vector3f& n0);
 
+/// The same fit on the points of `pts` whose plane lies nearer than `clear_depth` along their ray
+/// (the plane: `n_upright`, the upright fit of all of them, through their mean): the readings
+/// clear of the depth cut-off's noise band, where the cut-off has dropped none. Chosen by ray, not
+/// by reading, so that the choice does not depend on the noise; done twice. `n_upright` is returned
+/// unchanged unless at least half of the points (and 30) are clear. See manhattan_frame.cpp.
+Eigen::Vector3f fit_upright_normal_clear_of_cutoff(const std::vector<Eigen::Vector3f>& pts,
+                                                   const Eigen::Vector3f& up, const Eigen::Vector3f& n_upright,
+                                                   float clear_depth);
+
 /// k_M is the dominant direction closest to forward; near +-45 degrees both branches are about as
 /// close, so `yaw` is moved onto the branch of the `previous` k_M where that stays within 10
 /// degrees of 45 (hysteresis).
@@ -81,8 +92,10 @@ class ManhattanTracker {
  public:
   /// `max_range`: the depth (m) beyond which the sensor gives no reading (CaptureConfig::max_range);
   /// planes seen mostly within ManhattanConfig::range_clip_margin of it cannot make a frame of walls
-  /// alone (they still vote). 0: no such test.
-  explicit ManhattanTracker(const ManhattanConfig& config = {}, float max_range = 0.f);
+  /// alone (they still vote). 0: no such test. `depth_noise_coeff` (SegmentationConfig's: sigma =
+  /// coeff * z^2) sets the noise band at the cut-off that such a plane's yaw is fitted clear of.
+  explicit ManhattanTracker(const ManhattanConfig& config = {}, float max_range = 0.f,
+                            float depth_noise_coeff = SegmentationConfig{}.depth_noise_coeff);
 
   /// Estimates the Manhattan frame from the vertical planes among `regions`, given the floor
   /// (`T_floor_camera`; without a floor, the upright frame of a floor-like plane the floor's checks
@@ -132,6 +145,7 @@ class ManhattanTracker {
 
   ManhattanConfig cfg_;
   float max_range_ = 0.f;
+  float clear_depth_ = 0.f;  // m: 3 sigma of noise nearer than max_range_ (0: max_range_ unset)
   std::optional<float> prev_yaw_;
   std::vector<const Vote*> pair_candidates_;  // scratch: agreeing planes wide enough to make a pair
   std::vector<const Vote*> vetoes_;           // scratch: the walls that veto the frame
