@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/perception.hpp"
@@ -386,8 +386,8 @@ TEST(ManhattanFrame, WallReachingTheCutOffIsFittedClearOfIt) {
   EXPECT_LT(err_clear, 0.5 * err_upright);
 }
 
-// A wall seen mostly clear of the cut-off noise band keeps its readings' fit; one seen mostly
-// inside it keeps its upright fit (its clear part is too narrow to fix a yaw).
+// A wall seen mostly inside the cut-off's noise band keeps its upright fit (its clear part is too
+// narrow to fix a yaw), as it does with no cut-off known; clear of the band, it is fitted again.
 TEST(ManhattanFrame, WallInsideTheCutOffBandKeepsItsUprightFit) {
   const Eigen::Vector3f up(0.f, -1.f, 0.f), n(0.f, 0.f, -1.f);
   std::vector<Eigen::Vector3f> pts;
@@ -399,8 +399,8 @@ TEST(ManhattanFrame, WallInsideTheCutOffBandKeepsItsUprightFit) {
   EXPECT_LT((fit_upright_normal_clear_of_cutoff(pts, up, turned, 5.5f) - n).norm(), 1e-4f);
 }
 
-// Far walls fitted clear of the cut-off's noise band: the suite's sofa #0 (its far wall, 0.74 m
-// wide at 4.92 m, had let the sofa's frame stand 2.01 deg off) and seed 16's people #1 (2.18 deg
+// Far walls fitted clear of the cut-off's noise band: the suite's sofa #0 (its far wall, 1.06 m
+// wide at 4.77 m, had let the sofa's frame stand 2.01 deg off) and seed 16's people #1 (2.18 deg
 // off with a staircase in view, the one such frame on seeds 1-20) come within 2 deg.
 TEST(ManhattanFrame, FarWallsFittedClearOfTheCutOff) {
   const Case views[] = {{"sofa_static", 0, kSuiteSeed}, {"people_static", 1, 16}};

@@ -69,7 +69,8 @@ Eigen::Vector3f fit_upright_normal(const std::vector<Eigen::Vector3f>& pts, cons
 // reading itself: choosing readings by their depth would cut the noise again where the choice is
 // made. The plane's depth comes from the fit of all readings, biased a little, and is taken again
 // from the first refit. A plane seen mostly inside the band keeps its upright fit: its clear part
-// is too narrow to fix a yaw (a wall 0.74 m wide refitted on its nearest quarter came out 9 deg off).
+// is too narrow to fix a yaw (a wall 0.74 m wide refitted on its nearest quarter made a frame 9 deg
+// off).
 // This models nothing of the noise beyond its size at the cut-off, unlike the corrections README
 // tells of (a truncated normal's mean excess, a truncated-Gaussian likelihood), which the real
 // clouds refused; on their far walls it refits 2 of 14 planes, both nearer the truth
