@@ -173,6 +173,46 @@ TEST(SyntheticSensor, NoiseSigmaMatchesKinectModel) {
   }
 }
 
+// with_real_kinect_noise(): the same sigma, shared between neighbouring pixels (the white default
+// shares nothing). Its match to the real clouds is PerceptionRealData.
+// SyntheticNoiseCorrelatedAsTheRealClouds (test_perception).
+TEST(SyntheticSensor, CorrelatedNoiseKeepsTheKinectSigma) {
+  SynthOptions white;
+  white.dropout = 0.f;
+  const SynthOptions correlated = with_real_kinect_noise(white);
+  const CameraIntrinsics K = synthetic_intrinsics(white);
+  for (const float dist : {1.5f, 3.0f}) {
+    Scene s;
+    s.add_box_world({dist, -20.f, -20.f}, {dist + 0.2f, 20.f, 20.f}, plain(), "wall");
+    RenderBuffers buf;
+    render(s, camera_pose({0.f, 0.f, 0.f}, 0.f, 0.f, 0.f), K, buf);
+    double lag1[2] = {0, 0}, sigma[2] = {0, 0};
+    for (int k = 0; k < 2; ++k) {
+      double s2 = 0, sxy = 0;
+      long n = 0, m = 0;
+      for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+        cv::Mat depth;
+        apply_depth_sensor(buf, K, k == 0 ? white : correlated, seed, depth);
+        for (int v = 0; v < K.height; ++v)
+          for (int u = 0; u < K.width; ++u) {
+            const double e = depth.at<float>(v, u) - dist;
+            s2 += e * e, ++n;
+            if (u + 1 < K.width) sxy += e * (depth.at<float>(v, u + 1) - dist), ++m;
+          }
+      }
+      sigma[k] = std::sqrt(s2 / n);
+      lag1[k] = (sxy / m) / (s2 / n);
+    }
+    const double model = 1.425e-3 * dist * dist;
+    std::printf("[ noise ] z = %.2f m: sigma white %.2f mm, correlated %.2f mm, model %.2f mm; neighbours' "
+                "correlation white %.2f, correlated %.2f\n", dist, sigma[0] * 1e3, sigma[1] * 1e3, model * 1e3,
+                lag1[0], lag1[1]);
+    EXPECT_NEAR(sigma[1] / model, 1.0, 0.2) << "at " << dist << " m";
+    EXPECT_LT(lag1[0], 0.1) << "white noise at " << dist << " m";
+    EXPECT_GT(lag1[1], 0.5) << "correlated noise at " << dist << " m";
+  }
+}
+
 TEST(SyntheticSensor, RangeGrazingAndShadowHoles) {
   SynthOptions o;
   o.dropout = 0.f;

@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <limits>
 #include <map>
 #include <random>
 #include <vector>
@@ -371,7 +373,8 @@ bool stair_goes_up(const StairTruth& s) {
 // seen. Tracking starts cold at the first window and carries over the gaps between windows (as
 // for a sensor that dropped frames for a few seconds): the camera height remembered from the
 // floor seen earlier is what tells the tread underfoot from the treads below on a descent.
-void run_preset(const std::string& preset, long frames, std::uint32_t seed, long sequence_length, PresetFigures& F) {
+void run_preset(const std::string& preset, long frames, std::uint32_t seed, long sequence_length, PresetFigures& F,
+                const synth::SynthOptions& options = {}) {
   const long window = 8;
   std::vector<long> indices;
   if (sequence_length > 1) {
@@ -388,7 +391,7 @@ void run_preset(const std::string& preset, long frames, std::uint32_t seed, long
   FrameTruth truth_storage;
   const FrameTruth* truth = &truth_storage;
   for (std::size_t n = 0; n < indices.size(); ++n) {
-    synth::render_preset_frame(preset, indices[n], seed, synth::SynthOptions{}, frame, truth_storage);
+    synth::render_preset_frame(preset, indices[n], seed, options, frame, truth_storage);
     if (sequence_length <= 1 || n == 0) P.reset();
     timespec c0{}, c1{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
@@ -748,6 +751,40 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
     EXPECT_EQ(F.tread_bad_normal, 0) << "a tread found with its normal more than 2 deg off";
     EXPECT_EQ(F.tread_bad_class, 0) << "a tread found but not classed step candidate";
   }
+}
+
+// Issue 3's figures on the static presets again, with the depth noise correlated in space as the
+// real clouds' (synth::with_real_kinect_noise; the figures above are on white noise). Not the
+// issue's figures: what they become when the synthetic sensor is as unkind as the real one,
+// held as regression floors. Measured on the default seed (white noise in brackets): floor
+// 427/428 (427/428), wrong plane 0 (0), treads 512/514 (514/514, two found 1-2 cm off in
+// height), mixed 0 (0), Manhattan 200/222 (217/222), 1 frame more than 2 deg off with a staircase
+// in view (0), 11 with a wall in view (0).
+TEST(PerceptionPresetRealLikeNoise, FiguresOfIssue3) {
+  PresetFigures A;
+  const char* seed = getenv("SG_SEED");
+  for (const auto& p : synth::presets()) {
+    if (p.default_frames > 1) continue;
+    PresetFigures F;
+    run_preset(p.name, 24, seed ? static_cast<std::uint32_t>(std::strtoul(seed, nullptr, 10)) : 20261123u, 1, F,
+               synth::with_real_kinect_noise());
+    print(p.name, F);
+    A.floor_visible += F.floor_visible, A.floor_ok += F.floor_ok, A.floor_wrong_plane += F.floor_wrong_plane;
+    A.treads += F.treads, A.treads_ok += F.treads_ok, A.mixed += F.mixed;
+    A.manhattan_checked += F.manhattan_checked, A.manhattan_ok += F.manhattan_ok;
+    A.manhattan_wrong += F.manhattan_wrong, A.manhattan_off += F.manhattan_off;
+  }
+  std::printf("REAL-LIKE NOISE, STATIC PRESETS: floor %d/%d wrong plane %d | treads %d/%d mixed %d | manhattan %d/%d "
+              "(wrong %d, off with a wall in view %d)\n", A.floor_ok, A.floor_visible, A.floor_wrong_plane, A.treads_ok,
+              A.treads, A.mixed, A.manhattan_ok, A.manhattan_checked, A.manhattan_wrong, A.manhattan_off);
+  if (seed) return;  // the floors below are the default seed's
+  EXPECT_GE(A.floor_ok, 0.99 * A.floor_visible);
+  EXPECT_EQ(A.floor_wrong_plane, 0);
+  EXPECT_GE(A.treads_ok, 512) << "measured 512/514";
+  EXPECT_EQ(A.mixed, 0);
+  EXPECT_GE(A.manhattan_ok, 200) << "measured 200/222";
+  EXPECT_LE(A.manhattan_wrong, 1) << "measured 1 (people #2, 2.12 deg)";
+  EXPECT_LE(A.manhattan_off, 11) << "measured 11";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPresets, PerceptionPreset, ::testing::ValuesIn([] {
@@ -1112,4 +1149,102 @@ TEST(PerceptionRealData, KitchenManhattanFrameHoldsStillInTheWorld) {
   std::printf("kitchen: Manhattan frame on %zu of %zu views; world yaw within %.2f deg of the mean\n", world.k.size(),
               (files.size() + 9) / 10, worst / kDeg);
   EXPECT_LE(worst / kDeg, 2.5f);
+}
+
+
+// The residuals of the real clouds' big planes about their fit, correlated between pixels k
+// apart along a row (k = 1, 4, 8), averaged over the planes of 5000 pixels or more.
+namespace {
+std::array<double, 3> residual_correlation(const RgbdFrame& f, int& planes) {
+  Segmentation S;
+  std::vector<PlaneRegion> R;
+  std::vector<ObstacleCluster> C;
+  std::array<double, 3> mean{0, 0, 0};
+  planes = 0;
+  if (!S.run(f, R, C)) return mean;
+  const CameraIntrinsics& K = f.intrinsics;
+  std::vector<float> e(static_cast<std::size_t>(K.width * K.height));
+  for (const PlaneRegion& r : R) {
+    if (r.pixel_count < 5000) continue;
+    std::fill(e.begin(), e.end(), std::numeric_limits<float>::quiet_NaN());
+    auto ray_of = [&](int p, float& z) {
+      const int v = p / K.width, u = p - v * K.width;
+      z = f.depth.ptr<float>(v)[u];
+      return Eigen::Vector3d((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);
+    };
+    // Least squares in inverse depth, 1 / z = a . ray (as the segmentation fits planes).
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    float z = 0.f;
+    for (int p : r.pixels) {
+      const Eigen::Vector3d ray = ray_of(p, z);
+      if (!(z > 0.f)) continue;
+      A += ray * ray.transpose();
+      b += ray / z;
+    }
+    const Eigen::Vector3d a = A.ldlt().solve(b);
+    for (int p : r.pixels) {
+      const Eigen::Vector3d ray = ray_of(p, z);
+      if (z > 0.f) e[static_cast<std::size_t>(p)] = static_cast<float>(1.0 / z - a.dot(ray));
+    }
+    const int lags[3] = {1, 4, 8};
+    for (int i = 0; i < 3; ++i) {
+      double sxy = 0, sxx = 0, syy = 0;
+      for (int p : r.pixels) {
+        if (p % K.width + lags[i] >= K.width) continue;
+        const float x = e[static_cast<std::size_t>(p)], y = e[static_cast<std::size_t>(p + lags[i])];
+        if (std::isnan(x) || std::isnan(y)) continue;
+        sxy += x * y, sxx += x * x, syy += y * y;
+      }
+      mean[i] += sxy / std::sqrt(std::max(sxx * syy, 1e-300));
+    }
+    ++planes;
+  }
+  for (double& m : mean) m /= std::max(planes, 1);
+  return mean;
+}
+}  // namespace
+
+// The synthetic sensor's default noise is white: each pixel its own draw. A real structured-light
+// sensor's is not (it matches a window of its speckle pattern), and a plane fitted on N pixels of
+// correlated noise is fixed far less well than N independent readings would fix it: fitting on
+// every pixel instead of a subsample made synthetic far walls' yaw twice as good, and the real
+// clouds' no better. This measures the gap and checks the model of it
+// (synth::with_real_kinect_noise) against the real clouds.
+TEST(PerceptionRealData, SyntheticNoiseCorrelatedAsTheRealClouds) {
+  const std::string clouds = std::string(STAIRGUIDE_SHARED_DATA) + "/pcl-kinect-clouds";
+  std::ifstream probe(clouds + "/test/office1.pcd");
+  if (!probe) GTEST_SKIP() << "no real data at " << clouds;
+  auto add = [](std::array<double, 3>& sum, int& n, const std::array<double, 3>& c, int planes) {
+    for (int i = 0; i < 3; ++i) sum[i] += c[i] * planes;
+    n += planes;
+  };
+  std::array<double, 3> real{0, 0, 0}, white{0, 0, 0}, modelled{0, 0, 0};
+  int n_real = 0, n_white = 0, n_modelled = 0, planes = 0;
+  for (const char* name : {"office1", "five_people"}) {
+    const auto c = residual_correlation(read_pcd_frame(clouds + "/test/" + name + ".pcd"), planes);
+    add(real, n_real, c, planes);
+  }
+  RgbdFrame frame;
+  FrameTruth truth;
+  for (const char* preset : {"corridor_static", "ascending_static"}) {
+    for (int i : {0, 5}) {
+      synth::render_preset_frame(preset, i, 1, synth::SynthOptions{}, frame, truth);
+      add(white, n_white, residual_correlation(frame, planes), planes);
+      synth::render_preset_frame(preset, i, 1, synth::with_real_kinect_noise(), frame, truth);
+      add(modelled, n_modelled, residual_correlation(frame, planes), planes);
+    }
+  }
+  ASSERT_GE(n_real, 8) << "big planes in the real clouds (12 at the time of writing)";
+  ASSERT_GE(n_white, 8);
+  ASSERT_GE(n_modelled, 8);
+  const int lags[3] = {1, 4, 8};
+  for (int i = 0; i < 3; ++i) {
+    real[i] /= n_real, white[i] /= n_white, modelled[i] /= n_modelled;
+    std::printf("residual correlation at %d px: real %.2f (%d planes), synthetic white %.2f, synthetic modelled %.2f\n",
+                lags[i], real[i], n_real, white[i], modelled[i]);
+    EXPECT_NEAR(modelled[i], real[i], 0.15) << "the modelled noise's correlation at " << lags[i] << " px";
+  }
+  EXPECT_GT(real[0], 0.5) << "the real clouds' noise is correlated between neighbouring pixels";
+  EXPECT_LT(white[0], 0.1) << "the default synthetic noise is white";
 }

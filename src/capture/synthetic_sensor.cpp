@@ -37,6 +37,14 @@ inline float round_pos(float x) { return static_cast<float>(static_cast<int>(x +
 
 float depth_sigma_model(float z, const SynthOptions& o) { return o.sigma_coeff * z * z; }
 
+SynthOptions with_real_kinect_noise(SynthOptions o) {
+  o.noise_short_share = 0.6f;
+  o.noise_short_px = 2.f;
+  o.noise_long_share = 0.4f;
+  o.noise_long_px = 10.f;
+  return o;
+}
+
 float disparity_noise_sigma(float z, const SynthOptions& o) {
   const float F = o.disparity_focal_px * o.baseline_m;
   const float total = o.sigma_coeff * F;  // px: sigma_z = z^2 / F * sigma_d
@@ -115,11 +123,37 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
     sigma[static_cast<std::size_t>(i)] =
         disparity_noise_sigma(std::max(0.005f, 0.01f * static_cast<float>(i)), o);
   const std::uint64_t drop_threshold = static_cast<std::uint64_t>(std::clamp(o.dropout, 0.f, 1.f) * 65536.f);
+  // Correlated parts of the noise (SynthOptions::noise_*_share): white fields of their own streams,
+  // blurred and brought back to unit variance; the per-pixel draw below keeps the rest.
+  const float short_share = std::clamp(o.noise_short_share, 0.f, 1.f);
+  const float long_share = std::clamp(o.noise_long_share, 0.f, 1.f - short_share);
+  const float white_weight = std::sqrt(1.f - short_share - long_share);
+  cv::Mat correlated;
+  auto add_blurred = [&](float share, float blur_px, std::uint64_t salt) {
+    if (!(share > 0.f)) return;
+    cv::Mat field(H, W, CV_32FC1);
+    Stream s(seed ^ salt);
+    for (int v = 0; v < H; ++v) {
+      float* f = field.ptr<float>(v);
+      for (int u = 0; u < W; ++u) f[u] = g[(s.next() >> 48) & detail::kGaussianMask];
+    }
+    const float b = std::max(0.3f, blur_px);
+    const cv::Mat k = cv::getGaussianKernel(2 * static_cast<int>(std::ceil(3.f * b)) + 1, b, CV_32F);
+    cv::sepFilter2D(field, field, CV_32F, k, k, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT);
+    // The blurred field's variance: the kernel's sum of squares, squared (separable).
+    const double ss = k.dot(k);
+    field *= std::sqrt(share) / std::sqrt(ss * ss);
+    if (correlated.empty()) correlated = field;
+    else correlated += field;
+  };
+  add_blurred(short_share, o.noise_short_px, 0x5eed0001ull);
+  add_blurred(long_share, o.noise_long_px, 0x5eed0002ull);
   Stream rng(seed);
   for (int v = 0; v < H; ++v) {
     const float* z = ideal.depth.ptr<float>(v);
     float* out = depth_out.ptr<float>(v);
     const unsigned char* hr = &hole[static_cast<std::size_t>(v * W)];
+    const float* cr = correlated.empty() ? nullptr : correlated.ptr<float>(v);
     for (int u = 0; u < W; ++u) {
       const std::uint64_t r = rng.next();  // one draw per pixel keeps the stream aligned to pixels
       const float zp = z[u];
@@ -127,8 +161,9 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
         out[u] = 0.f;
         continue;
       }
-      float d =
-          F / zp + sigma[static_cast<std::size_t>(zp * 100.f + 0.5f)] * g[(r >> 48) & detail::kGaussianMask];
+      float n = g[(r >> 48) & detail::kGaussianMask];
+      if (cr) n = white_weight * n + cr[u];
+      float d = F / zp + sigma[static_cast<std::size_t>(zp * 100.f + 0.5f)] * n;
       if (d <= 0.5f * q) {
         out[u] = 0.f;
         continue;
