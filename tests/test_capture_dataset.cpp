@@ -379,6 +379,16 @@ TEST(OpenFrameSource, PicksTheSourceByInputName) {
   EXPECT_NE(e.find("no_such_scene"), std::string::npos) << e;
   e = error_of([&] { open_frame_source("synth:ascending_static:many", c); });
   EXPECT_NE(e.find("FRAMES"), std::string::npos) << e;
+  // NOISE: white (the default) or kinect, correlated in space as the real sensor's.
+  RgbdFrame w, k;
+  ASSERT_TRUE(open_frame_source("synth:ascending_static:1:5:white", c)->read(w).ok());
+  ASSERT_TRUE(open_frame_source("synth:ascending_static:1:5", c)->read(f).ok());
+  ASSERT_TRUE(open_frame_source("synth:ascending_static:1:5:kinect", c)->read(k).ok());
+  EXPECT_EQ(cv::norm(w.depth, f.depth, cv::NORM_INF), 0.0) << "white is the default";
+  EXPECT_GT(cv::norm(w.depth, k.depth, cv::NORM_INF), 0.0) << "kinect noise differs";
+  e = error_of([&] { open_frame_source("synth:ascending_static:1:5:pink", c); });
+  EXPECT_NE(e.find("NOISE"), std::string::npos) << e;
+  EXPECT_NE(e.find("pink"), std::string::npos) << e;
 }
 
 TEST(RealData, SevenScenesRedkitchen) {

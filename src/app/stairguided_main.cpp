@@ -26,7 +26,7 @@ namespace {
 using namespace stairguide;
 
 constexpr const char* kUsage =
-    "usage: stairguided [--config FILE] [--replay FILE.oni|DIR|synth:SCENE[:FRAMES[:SEED]]]\n"
+    "usage: stairguided [--config FILE] [--replay FILE.oni|DIR|synth:SCENE[:FRAMES[:SEED[:NOISE]]]]\n"
     "                   [--realtime|--fast] [--sync] [--frames N] [--no-frame-lines]\n"
     "       stairguided --check-config FILE\n"
     "\n"

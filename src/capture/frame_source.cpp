@@ -23,7 +23,8 @@ long parse_count(const std::string& s, const std::string& input, const char* wha
 }
 
 std::unique_ptr<FrameSource> open_synth(const std::string& input) {
-  // synth:SCENE[:FRAMES[:SEED]]
+  // synth:SCENE[:FRAMES[:SEED[:NOISE]]], NOISE white (the default) or kinect
+  // (synth::with_real_kinect_noise: correlated in space as the real sensor's)
   std::vector<std::string> parts;
   std::size_t start = 0;
   for (;;) {
@@ -32,18 +33,24 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
     if (c == std::string::npos) break;
     start = c + 1;
   }
-  if (parts.size() < 2 || parts.size() > 4 || parts[1].empty())
+  if (parts.size() < 2 || parts.size() > 5 || parts[1].empty())
     throw SourceError("input '" + input +
-                      "': expected synth:SCENE[:FRAMES[:SEED]] (see 'stairguide synth --list')");
+                      "': expected synth:SCENE[:FRAMES[:SEED[:NOISE]]] (see 'stairguide synth --list')");
   long frames = -1;
   for (const auto& p : synth::presets())
     if (p.name == parts[1]) frames = p.default_frames;
   if (parts.size() >= 3 && !parts[2].empty()) frames = parse_count(parts[2], input, "FRAMES");
   if (frames == 0) throw SourceError("input '" + input + "': FRAMES must be at least 1");
   std::uint32_t seed = 1;
-  if (parts.size() == 4) seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
+  if (parts.size() >= 4 && !parts[3].empty()) seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
+  synth::SynthOptions options;
+  if (parts.size() == 5) {
+    if (parts[4] == "kinect") options = synth::with_real_kinect_noise(options);
+    else if (parts[4] != "white")
+      throw SourceError("input '" + input + "': NOISE must be 'white' or 'kinect', got '" + parts[4] + "'");
+  }
   // An unknown scene name is reported by make_source (its message lists the presets).
-  return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed);
+  return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed, options);
 }
 
 // capture.min_range_m / max_range_m: depth outside them is no reading, for every consumer
@@ -108,7 +115,7 @@ std::unique_ptr<FrameSource> open_ungated(const std::string& input, const Captur
   if (!fs::exists(input, ec)) throw SourceError("input '" + input + "': no such file or directory");
   throw SourceError("input '" + input +
                     "': unknown kind (expected a dataset folder, FILE.oni, FILE.pcd, FILE.png, device[:URI] "
-                    "or synth:SCENE[:FRAMES[:SEED]])");
+                    "or synth:SCENE[:FRAMES[:SEED[:NOISE]]])");
 }
 
 }  // namespace

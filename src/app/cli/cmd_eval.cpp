@@ -1,5 +1,5 @@
 // `stairguide eval INPUT... [--json]`: stair detection and modelling scored against ground truth.
-// Inputs: dataset folders with labels.yaml, "synth:PRESET[:FRAMES[:SEED]]" (the renderer directly;
+// Inputs: dataset folders with labels.yaml, "synth:PRESET[:FRAMES[:SEED[:NOISE]]]" (the renderer directly;
 // "synth:all:FRAMES:SEED" runs every preset), or a labels.csv of single frames (path,label,kind,note;
 // paths relative to the file) whose labels carry no pose. The accuracy claims come from here.
 #include <cstdio>
@@ -230,7 +230,7 @@ int eval(Context& ctx) {
 }  // namespace
 
 SG_COMMAND("eval", "eval INPUT... [--json] [--verbose]",
-           "score stair detection on labelled inputs: dataset folders, synth:PRESET[:FRAMES[:SEED]], labels.csv",
+           "score stair detection on labelled inputs: dataset folders, synth:PRESET[:FRAMES[:SEED[:NOISE]]], labels.csv",
            eval);
 
 }  // namespace stairguide::cli
