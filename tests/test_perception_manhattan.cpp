@@ -28,10 +28,11 @@ struct Case {
   std::uint32_t seed;
 };
 
-View run_view(const std::string& preset, long index, std::uint32_t seed, const ManhattanConfig& manhattan = {}) {
+View run_view(const std::string& preset, long index, std::uint32_t seed, const ManhattanConfig& manhattan = {},
+              const synth::SynthOptions& options = {}) {
   View v;
   RgbdFrame frame;
-  synth::render_preset_frame(preset, index, seed, synth::SynthOptions{}, frame, v.truth);
+  synth::render_preset_frame(preset, index, seed, options, frame, v.truth);
   Perception P(SegmentationConfig{}, FloorConfig{}, manhattan);
   P.process(frame, v.sc);
   v.yaw_err = sg_test::manhattan_yaw_error_deg(v.sc, v.truth);
@@ -209,7 +210,65 @@ PlaneRegion tilted_band(const Pose& T_floor_camera, float yaw, float tilt, float
                    length, 0.07f, 0.01f);
 }
 
+/// An upright rectangle `width` x `height` standing on the floor, its foot's centre `ahead` m in
+/// front of the camera, its normal at `yaw` (rad) from z_F facing the camera; points every `step` m.
+PlaneRegion upright_on_floor(const Pose& T_floor_camera, float ahead, float yaw, float width, float height,
+                             float step) {
+  const Eigen::Vector3f n_f(-std::sin(yaw), 0.f, -std::cos(yaw));
+  const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 0.5f * height, ahead), n_f, along_f,
+                   Eigen::Vector3f::UnitY(), width, height, step);
+}
+
+/// The floor from `from` to `to` m ahead, 4 m wide; points every 5 cm.
+PlaneRegion floor_between(const Pose& T_floor_camera, float from, float to) {
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 0.f, 0.5f * (from + to)), Eigen::Vector3f::UnitY(),
+                   Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitZ(), 4.f, to - from, 0.05f);
+}
+
 }  // namespace
+
+// A wall 4.6 m away and 0.6 m wide (ManhattanConfig::far_wall_range, far_wall_width) is the only
+// wall in view, its yaw 4 deg off as the real sensor's far walls are; a riser 1.5 m wide stands
+// 2.5 m away with the floor going on beyond it. The walls' frame alone would be the wall's; the
+// riser, within far_wall_agreement of it, gives the frame instead (with the real-like noise such
+// walls made frames 2 to 5 deg off with a staircase in view). Furniture turned 20 deg against the
+// room keeps the wall's frame, and so does a riser beside a wall near enough to fix its yaw.
+TEST(ManhattanFrame, FarNarrowWallYieldsToNearerPlanesAgreeingWithIt) {
+  const Pose T = level_camera();
+  const float deg = 3.14159265f / 180.f;
+  const float wall_yaw = 4.f * deg;
+  const ManhattanConfig cfg;
+  auto frame = [&](float riser_yaw, float wall_ahead, const ManhattanConfig& c) {
+    ManhattanTracker m(c);
+    return m.estimate({floor_between(T, 0.8f, wall_ahead), upright_on_floor(T, wall_ahead, wall_yaw, 0.6f, 0.4f, 0.02f),
+                       upright_on_floor(T, 2.5f, riser_yaw, 1.5f, 0.17f, 0.02f)},
+                      T);
+  };
+  {
+    const ManhattanEstimate e = frame(0.f, 4.6f, cfg);
+    ASSERT_TRUE(e.found) << e.why;
+    // The riser's frame, with the wall's vote in it (area x width^2: a sixth of the riser's weight).
+    EXPECT_LT(std::fabs(e.yaw), 1.5f * deg) << "the far wall's frame, " << e.yaw / deg << " deg";
+  }
+  {
+    ManhattanConfig walls_first = cfg;
+    walls_first.far_wall_agreement = 0.f;
+    const ManhattanEstimate e = frame(0.f, 4.6f, walls_first);
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg) << "without the rule, the walls' frame: the test does not test";
+  }
+  {
+    const ManhattanEstimate e = frame(20.f * deg, 4.6f, cfg);
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg) << "furniture turned 20 deg took the frame from the wall";
+  }
+  {
+    const ManhattanEstimate e = frame(0.f, 3.5f, cfg);
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg) << "a wall 3.5 m away yielded to the riser";
+  }
+}
 
 // The compass only says which planes to believe: a plane too narrow to make a frame alone
 // (0.3 m, floating) makes one when the image edges agree with it within compass_agreement (the
@@ -405,4 +464,27 @@ TEST(ManhattanFrame, WallInsideTheCutOffBandKeepsItsUprightFit) {
 TEST(ManhattanFrame, FarWallsFittedClearOfTheCutOff) {
   const Case views[] = {{"sofa_static", 0, kSuiteSeed}, {"people_static", 1, 16}};
   for (const Case& c : views) expect_frame_within_2deg(c, 500);
+}
+
+// With the depth noise correlated as the real sensor's (synth::with_real_kinect_noise), a far
+// narrow wall, the only wall in view, made these frames 2.8 to 4.3 deg off with a staircase (or a
+// person on one) in view, against risers nearer and wider that agree with it within
+// far_wall_agreement; the risers' frame is within 2 deg. On seeds 1-12 of the static presets so
+// measured, frames off with a staircase in view went from 36 to 21 and right frames from 2628 to
+// 2639 of 2906.
+TEST(ManhattanFrame, FarNarrowWallsYieldWithRealLikeNoise) {
+  const Case views[] = {{"single_step_static", 4, 1}, {"single_step_static", 17, 3}, {"open_risers_static", 6, 6},
+                        {"single_step_static", 16, 10}, {"people_static", 9, 5}};
+  ManhattanConfig walls_first;
+  walls_first.far_wall_agreement = 0.f;
+  const synth::SynthOptions real_like = synth::with_real_kinect_noise();
+  for (const Case& c : views) {
+    const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+    const View v = run_view(c.preset, c.index, c.seed, ManhattanConfig{}, real_like);
+    ASSERT_TRUE(v.truth.any_stair_visible()) << name;
+    EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
+    EXPECT_LE(v.yaw_err, 2.f) << name;
+    const View w = run_view(c.preset, c.index, c.seed, walls_first, real_like);
+    EXPECT_GT(w.yaw_err, 2.f) << name << ": the far wall's frame is no longer off, the test does not test";
+  }
 }

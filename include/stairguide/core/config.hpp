@@ -233,6 +233,9 @@ struct ManhattanConfig {
   float floor_beyond_height = 0.05f;  ///< m, horizontal planes within this of the floor count as floor for that test
   float min_bounding_width = 0.2f;    ///< m, min_plane_width for planes standing on the floor with no floor beyond them (walls)
   float range_clip_margin = 0.25f;    ///< m, a vertical plane with most points this near the depth cut-off cannot make a frame of walls alone
+  float far_wall_range = 4.0f;        ///< m, a wall this far away (its centroid) ...
+  float far_wall_width = 1.0f;        ///< m, ... and narrower than this has a yaw good to a few degrees only on the real sensor ...
+  float far_wall_agreement = 0.08726646f;  ///< rad, ... so a frame only such walls make yields to the frame of all the planes within this of it (5 deg)
   float structure_beyond_area = 0.02f;  ///< m^2, other surfaces this large beyond a vertical plane make it no wall; a wall this large beyond a frame's plane may veto it ...
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
@@ -276,6 +279,14 @@ struct ManhattanConfig {
     v.num(range_clip_margin, "range_clip_margin_cm", Unit::kCentimetre, 0, 200,
           "a vertical plane with most of its points this near the depth cut-off (capture max_range) cannot make a "
           "frame of walls alone: its fit may be biased");
+    v.num(far_wall_range, "far_wall_range_cm", Unit::kCentimetre, 0, 1000,
+          "a wall (a vertical plane on the floor, nothing beyond it) whose centroid is this far from the camera ...");
+    v.num(far_wall_width, "far_wall_width_cm", Unit::kCentimetre, 0, 1000,
+          "... and narrower than this has a yaw good to a few degrees only: the real sensor's depth noise there is "
+          "centimetres, correlated over tens of pixels ...");
+    v.num(far_wall_agreement, "far_wall_agreement_deg", Unit::kDegree, 0, 45,
+          "... so when such walls alone make the frame and all the vertical planes together (risers, furniture: "
+          "nearer, wider) make one within this of it, that one is taken; 0: never");
     v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
           "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
           "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "

@@ -127,6 +127,9 @@ class ManhattanTracker {
     // A band along a level axis tilted beyond vertical_tolerance: its heading is its axis's; it
     // only joins planes that the image edges confirm (confirm()).
     bool tilted = false;
+    // At least ManhattanConfig::far_wall_range away and narrower than far_wall_width: its yaw is
+    // good to a few degrees only on the real sensor.
+    bool far = false;
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
