@@ -58,8 +58,8 @@ struct OdometryAndPerception {
 };
 
 // Every frame of `preset` through DenseOdometry and Perception.
-WalkFigures run_walk(const std::string& preset, long frames) {
-  auto src = synth::make_source(preset, frames, kSeed);
+WalkFigures run_walk(const std::string& preset, long frames, const synth::SynthOptions& options = {}) {
+  auto src = synth::make_source(preset, frames, kSeed, options);
   OdometryAndPerception run(src->intrinsics());
   RgbdFrame f;
   SceneResult sc;
@@ -110,12 +110,14 @@ struct Walk {
   const char* preset;
   long frames;
   int misses;
+  bool real_like_noise = false;  // synth::with_real_kinect_noise(): depth noise correlated as the real sensor's
 };
 class WalkManhattan : public ::testing::TestWithParam<Walk> {};
 
 TEST_P(WalkManhattan, FrameHeldByOurOdometry) {
   const Walk walk = GetParam();
-  const WalkFigures W = run_walk(walk.preset, walk.frames);
+  const WalkFigures W =
+      run_walk(walk.preset, walk.frames, walk.real_like_noise ? synth::with_real_kinect_noise() : synth::SynthOptions{});
   EXPECT_EQ(W.wrong, 0) << "a Manhattan frame more than 2 deg off";
   EXPECT_EQ(W.odometry_failures, 0);
   EXPECT_LE(W.worst_carried, 2.f);
@@ -136,6 +138,17 @@ INSTANTIATE_TEST_SUITE_P(
         Walk{"ascending_approach_climb", 600, 0},  // 374/374
         // No wall or riser face in view on the way down: no frame may be off with the flight in view.
         Walk{"descending_approach_descend", 600, 0}, Walk{"descending_people_approach", 300, 0}),
+    [](const ::testing::TestParamInfo<Walk>& info) { return std::string(info.param.preset); });
+
+// The same walks with the depth noise correlated in space as the real sensor's, where a view's own
+// frame is off or missing more often (static views: 200/222 against 217/222 on white noise): the
+// odometry still tracks every frame, and the frame it holds is never more than 2 deg off.
+// Measured: the fast turn 121/123 (91 view by view), the approach and climb 374/374 (not run
+// here: 12 s); no frame off on either or on the walk down past a person (7 views given the held
+// frame there, within 1.36 deg).
+INSTANTIATE_TEST_SUITE_P(
+    WalksRealLikeNoise, WalkManhattan,
+    ::testing::Values(Walk{"ascending_turn_fast", 300, 2, true}, Walk{"descending_people_approach", 300, 0, true}),
     [](const ::testing::TestParamInfo<Walk>& info) { return std::string(info.param.preset); });
 
 // The real 7-Scenes kitchen, hand-held, every frame: perception alone (the frame each view makes,
