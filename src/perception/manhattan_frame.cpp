@@ -322,15 +322,16 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   ManhattanEstimate frame;
   if (any_bounding) frame = solve(votes, total_area, /*bounding_only=*/true);
   // A frame that only far, narrow walls make (`far`) is good to a few degrees on the real sensor,
-  // not to the 2 deg asked: its depth noise is 2 to 4 cm there and correlated over tens of pixels
-  // (the real clouds' far walls, held upright, are 5 deg off on average:
+  // not to the 2 deg asked: its depth noise is 2 to 4 cm there and correlated between neighbouring
+  // pixels (the real clouds' far walls, held upright, are 5 deg off on average:
   // PerceptionRealData.FarWallsAtTheCutOffHeldUprightAreNoWorse), and the synthetic walls so seen
-  // were 5 to 7 deg off with the real-like noise, against risers 1.5 m wide 2.5 m away within
+  // were 3 to 7 deg off with the real-like noise, against risers 1.5 m wide 2.5 m away within
   // 0.3 deg. When all the vertical planes together (risers, furniture, nearer and wider) make a
-  // frame within far_wall_agreement of the walls', the walls cannot tell it wrong: theirs is
-  // taken, and faces the walls' veto below as any other. Furniture turned by more against the room
-  // keeps the walls' frame. (With white noise the far walls are right to a degree, and the frames
-  // of furniture turned 2 to 4 deg come out that far off instead: 6 of 4815 views on seeds 1-20.)
+  // frame within far_wall_agreement of the walls', the walls cannot show that frame wrong, and it
+  // is taken; it then faces the walls' veto below as any other. Furniture turned further against
+  // the room keeps the walls' frame. (With white noise the far walls are right to a degree, and
+  // furniture turned 2 to 4 deg now gives its frame, that far off: on seeds 1-20, 6 more frames
+  // off with a wall in view of 4815 views, none with a staircase in view.)
   if (frame.found && cfg_.far_wall_agreement > 0.f) {
     bool near_wall = false;
     for (const Vote& v : votes)

@@ -283,7 +283,7 @@ struct ManhattanConfig {
           "a wall (a vertical plane on the floor, nothing beyond it) whose centroid is this far from the camera ...");
     v.num(far_wall_width, "far_wall_width_cm", Unit::kCentimetre, 0, 1000,
           "... and narrower than this has a yaw good to a few degrees only: the real sensor's depth noise there is "
-          "centimetres, correlated over tens of pixels ...");
+          "centimetres, correlated between neighbouring pixels ...");
     v.num(far_wall_agreement, "far_wall_agreement_deg", Unit::kDegree, 0, 45,
           "... so when such walls alone make the frame and all the vertical planes together (risers, furniture: "
           "nearer, wider) make one within this of it, that one is taken; 0: never");
