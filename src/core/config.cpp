@@ -99,6 +99,10 @@ std::vector<std::string> check_consistency(const PipelineConfig& c) {
   order(c.floor.tilt_min, c.floor.tilt_max, "floor.tilt_min_deg", "floor.tilt_max_deg");
   order(c.floor.height_min, c.floor.height_max, "floor.height_min_m", "floor.height_max_m");
   order(c.floor.search_start, c.floor.search_max, "floor.search_start_m", "floor.search_max_m");
+  order(c.manhattan.riser_min_height, c.manhattan.riser_max_height, "manhattan.riser_min_height_cm",
+        "manhattan.riser_max_height_cm");
+  order(c.manhattan.riser_going_min, c.manhattan.riser_going_max, "manhattan.riser_going_min_cm",
+        "manhattan.riser_going_max_cm");
   order(c.classification.step_height_min, c.classification.step_height_max,
         "classification.step_height_min_cm", "classification.step_height_max_cm");
   order(c.stair_modelling.riser_min, c.stair_modelling.riser_max, "stair_modelling.riser_min_cm",

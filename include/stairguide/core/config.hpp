@@ -236,6 +236,14 @@ struct ManhattanConfig {
   float far_wall_range = 4.0f;        ///< m, a wall this far away (its centroid) ...
   float far_wall_width = 1.0f;        ///< m, ... and narrower than this has a yaw good to a few degrees only on the real sensor ...
   float far_wall_agreement = 0.08726646f;  ///< rad, ... so a frame only such walls make yields to the frame of all the planes within this of it (5 deg)
+  float riser_min_height = 0.10f;      ///< m, a vertical plane at least this tall ...
+  float riser_max_height = 0.22f;      ///< m, ... and at most this, with a tread on its top edge, may be a riser
+  float riser_tread_tolerance = 0.03f;  ///< m, a horizontal plane within this of a riser's top (bottom) edge's height is its tread (the one below)
+  float riser_going_min = 0.15f;       ///< m, two such planes, one standing on the other's tread this far beyond it ...
+  float riser_going_max = 0.6f;        ///< m, ... and at most this, are a flight's risers
+  float single_riser_min_width = 0.8f;  ///< m, one standing on the floor is a riser (a single step, a curb) when this wide ...
+  float single_riser_min_depth = 0.6f;  ///< m, ... and its tread is seen to go on this far beyond it
+  float riser_agreement = 0.17453293f;  ///< rad, risers make the frame over far walls within this of them, and far walls cannot veto it (10 deg); 0: never
   float structure_beyond_area = 0.02f;  ///< m^2, other surfaces this large beyond a vertical plane make it no wall; a wall this large beyond a frame's plane may veto it ...
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
@@ -287,6 +295,26 @@ struct ManhattanConfig {
     v.num(far_wall_agreement, "far_wall_agreement_deg", Unit::kDegree, 0, 45,
           "... so when such walls alone make the frame and all the vertical planes together (risers, furniture: "
           "nearer, wider) make one within this of it, that one is taken; 0: never");
+    v.num(riser_min_height, "riser_min_height_cm", Unit::kCentimetre, 0, 100,
+          "a vertical plane at least this tall ...");
+    v.num(riser_max_height, "riser_max_height_cm", Unit::kCentimetre, 0, 100,
+          "... and at most this, with a tread on its top edge (a horizontal plane starting there and going on beyond "
+          "it), may be a riser ...");
+    v.num(riser_tread_tolerance, "riser_tread_tolerance_cm", Unit::kCentimetre, 0, 20,
+          "... the tread within this of its top edge's height; the plane stands on the floor or on another tread "
+          "(within this of its bottom edge's height, in front of it) ...");
+    v.num(riser_going_min, "riser_going_min_cm", Unit::kCentimetre, 0, 200,
+          "... and two such planes, one standing on the other's tread at least this far beyond it ...");
+    v.num(riser_going_max, "riser_going_max_cm", Unit::kCentimetre, 0, 200,
+          "... and at most this, are a flight's risers ...");
+    v.num(single_riser_min_width, "single_riser_min_width_cm", Unit::kCentimetre, 0, 1000,
+          "... and one standing on the floor alone is a riser (a single step, a curb) when this wide ...");
+    v.num(single_riser_min_depth, "single_riser_min_depth_cm", Unit::kCentimetre, 0, 1000,
+          "... and its tread is seen to go on this far beyond it (a shelf's plinth and bottom board: 30-45 cm)");
+    v.num(riser_agreement, "riser_agreement_deg", Unit::kDegree, 0, 45,
+          "the risers' frame is the staircase's own: where only walls far_wall_range_cm away or at the depth cut-off "
+          "make the walls' frame, the risers' frame within this of it is taken, and such walls cannot veto a frame "
+          "that risers agree with; 0: risers have no such standing");
     v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
           "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
           "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "

@@ -130,6 +130,13 @@ class ManhattanTracker {
     // At least ManhattanConfig::far_wall_range away and narrower than far_wall_width: its yaw is
     // good to a few degrees only on the real sensor.
     bool far = false;
+    float range = 0.f;  // m, its centroid's distance from the camera
+    float base = 0.f;   // m, its lowest point's height above the floor
+    float top = 0.f;    // m, its highest point's height above the floor
+    // A riser of a flight, a single step or a curb (mark_risers): the staircase's own direction,
+    // which a far wall's cannot overrule.
+    bool riser = false;
+    float tread_depth = 0.f;  // m, how far the tread on its top edge is seen to go on beyond it
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
@@ -142,7 +149,11 @@ class ManhattanTracker {
   float disagree_tolerance(const Vote& v) const;
   /// Width from which an agreeing plane makes the frame trusted on its own.
   float min_width(const Vote& v, bool bounding_only) const;
-  ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, bool bounding_only);
+  /// Which votes solve() counts: the planes that bound the room, all of them, or the risers.
+  enum class Voters { kBounding, kAll, kRisers };
+  ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, Voters voters);
+  /// Sets Vote::riser and tread_depth (see manhattan_frame.cpp).
+  void mark_risers(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
   /// The frame of the planes agreeing with the image edges' direction (see estimate()).
   ManhattanEstimate confirm(const std::vector<Vote>& votes, float total_area, const EdgeCompassResult& compass) const;
 
@@ -156,6 +167,7 @@ class ManhattanTracker {
   std::vector<FloorSample> floor_pts_;    // scratch
   std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
   std::vector<std::size_t> region_samples_;  // scratch: region k's samples start at [k], end at [k + 1]
+  std::vector<char> stacked_;                // scratch: mark_risers' candidates on or under another
 };
 
 }  // namespace stairguide
