@@ -286,10 +286,11 @@ TEST(ManhattanFrame, FarNarrowWallYieldsToNearerPlanesAgreeingWithIt) {
 
 // A wall 4.6 m away, 0.6 m wide, is the only wall in view, its yaw 7 deg off as the real sensor's
 // far walls are (2.5 to 7 deg in the synthetic views with real-like noise); the staircase's risers
-// nearer by 2 m are right to a few tenths. Risers (ManhattanConfig::riser_*) make the frame over
-// such walls within riser_agreement; planes that carry a level surface but are no risers do not: a
-// sofa's back cushion on its seat (standing on no step) and a shelf's plinth under its bottom board
-// (0.34 m deep; a single step's tread goes on 0.6 m or more).
+// nearer by 2 m are right to a few tenths. Risers (ManhattanConfig::riser_*: a flight's, open risers'
+// tread fronts, a single step's) make the frame over such walls within riser_agreement; planes that
+// carry a level surface but are no risers do not: a sofa's back cushion on its seat (one such plane,
+// not a flight) and a shelf's plinth under its bottom board (0.34 m deep; a single step's tread goes
+// on 0.6 m or more).
 TEST(ManhattanFrame, RisersOverruleFarWalls) {
   const Pose T = level_camera();
   const float deg = 3.14159265f / 180.f;
@@ -317,6 +318,16 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
     const ManhattanEstimate w = frame(flight(0.f), no_risers);
     ASSERT_TRUE(w.found) << w.why;
     EXPECT_NEAR(w.yaw, wall_yaw, 0.1f * deg) << "without the rule, the wall's frame: the test does not test";
+  }
+  {
+    // Open risers: each tread's front, 5 cm tall, carries it; no riser below.
+    std::vector<PlaneRegion> open;
+    for (int k = 0; k < 3; ++k)
+      for (PlaneRegion& r : step(T, 2.5f + 0.28f * k, 0.f, 1.0f, 0.17f * (k + 1) - 0.05f, 0.05f, 0.25f))
+        open.push_back(r);
+    const ManhattanEstimate e = frame(open, cfg);
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "open risers' tread fronts: the far wall's frame, " << e.yaw / deg << " deg";
   }
   {
     const ManhattanEstimate e = frame(step(T, 2.5f, 0.f, 1.2f, 0.f, 0.17f, 1.0f), cfg);
@@ -564,13 +575,15 @@ TEST(ManhattanFrame, FarNarrowWallsYieldWithRealLikeNoise) {
 
 // With the real-like noise, a far wall (4.2 to 4.9 m away) made these frames 2.3 to 7 deg off with
 // a staircase in view, or left it without a frame by its veto, against a flight's or a single
-// step's risers within 0.3 deg: the risers now make the frame (ManhattanConfig::riser_*). The views
+// step's risers (or open risers' tread fronts) within 0.35 deg: the risers now make the frame
+// (ManhattanConfig::riser_*). The views
 // of a sofa and of shelves whose cushion or plinth first passed for a riser (frames 7 and 6 deg
 // off, real-like noise; 4.5 deg, white) are no more than 2 deg off.
 TEST(ManhattanFrame, RisersOverruleFarWallsWithRealLikeNoise) {
   const Case views[] = {{"handrails_open_sides_static", 18, 11}, {"handrails_open_sides_static", 9, 4},
                         {"handrails_open_sides_static", 21, 8},  {"single_step_static", 22, 5},
-                        {"single_step_static", 6, 2},            {"ascending_short_static", 23, 12}};
+                        {"single_step_static", 6, 2},            {"ascending_short_static", 23, 12},
+                        {"open_risers_static", 7, 12}};
   ManhattanConfig no_risers;
   no_risers.riser_agreement = 0.f;
   const synth::SynthOptions real_like = synth::with_real_kinect_noise();

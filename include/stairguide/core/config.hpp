@@ -236,10 +236,10 @@ struct ManhattanConfig {
   float far_wall_range = 4.0f;        ///< m, a wall this far away (its centroid) ...
   float far_wall_width = 1.0f;        ///< m, ... and narrower than this has a yaw good to a few degrees only on the real sensor ...
   float far_wall_agreement = 0.08726646f;  ///< rad, ... so a frame only such walls make yields to the frame of all the planes within this of it (5 deg)
-  float riser_min_height = 0.10f;      ///< m, a vertical plane at least this tall ...
-  float riser_max_height = 0.22f;      ///< m, ... and at most this, with a tread on its top edge, may be a riser
-  float riser_tread_tolerance = 0.03f;  ///< m, a horizontal plane within this of a riser's top (bottom) edge's height is its tread (the one below)
-  float riser_going_min = 0.15f;       ///< m, two such planes, one standing on the other's tread this far beyond it ...
+  float riser_max_height = 0.22f;      ///< m, a vertical plane at most this tall with a tread on its top edge may be a riser (or an open riser's tread front)
+  float riser_tread_tolerance = 0.03f;  ///< m, a horizontal plane within this of its top edge's height is its tread
+  float riser_min_height = 0.10f;      ///< m, two such planes whose treads are this much apart in height ...
+  float riser_going_min = 0.15f;       ///< m, ... and the one this far beyond the other ...
   float riser_going_max = 0.6f;        ///< m, ... and at most this, are a flight's risers
   float single_riser_min_width = 0.8f;  ///< m, one standing on the floor is a riser (a single step, a curb) when this wide ...
   float single_riser_min_depth = 0.6f;  ///< m, ... and its tread is seen to go on this far beyond it
@@ -295,20 +295,21 @@ struct ManhattanConfig {
     v.num(far_wall_agreement, "far_wall_agreement_deg", Unit::kDegree, 0, 45,
           "... so when such walls alone make the frame and all the vertical planes together (risers, furniture: "
           "nearer, wider) make one within this of it, that one is taken; 0: never");
-    v.num(riser_min_height, "riser_min_height_cm", Unit::kCentimetre, 0, 100,
-          "a vertical plane at least this tall ...");
     v.num(riser_max_height, "riser_max_height_cm", Unit::kCentimetre, 0, 100,
-          "... and at most this, with a tread on its top edge (a horizontal plane starting there and going on beyond "
-          "it), may be a riser ...");
+          "a vertical plane at most this tall with a tread on its top edge (a horizontal plane starting there and "
+          "going on beyond it) may be a riser, or an open riser's tread front ...");
     v.num(riser_tread_tolerance, "riser_tread_tolerance_cm", Unit::kCentimetre, 0, 20,
-          "... the tread within this of its top edge's height; the plane stands on the floor or on another tread "
-          "(within this of its bottom edge's height, in front of it) ...");
+          "... the tread within this of its top edge's height ...");
+    v.num(riser_min_height, "riser_min_height_cm", Unit::kCentimetre, 0, 100,
+          "... and two such planes whose treads lie at least this much apart in height (at most riser_max_height_cm) "
+          "...");
     v.num(riser_going_min, "riser_going_min_cm", Unit::kCentimetre, 0, 200,
-          "... and two such planes, one standing on the other's tread at least this far beyond it ...");
+          "... the one at least this far beyond the other ...");
     v.num(riser_going_max, "riser_going_max_cm", Unit::kCentimetre, 0, 200,
-          "... and at most this, are a flight's risers ...");
+          "... and at most this, are a flight's risers; one standing on the floor alone, at least riser_min_height_cm "
+          "tall ...");
     v.num(single_riser_min_width, "single_riser_min_width_cm", Unit::kCentimetre, 0, 1000,
-          "... and one standing on the floor alone is a riser (a single step, a curb) when this wide ...");
+          "... is a riser (a single step, a curb) when this wide ...");
     v.num(single_riser_min_depth, "single_riser_min_depth_cm", Unit::kCentimetre, 0, 1000,
           "... and its tread is seen to go on this far beyond it (a shelf's plinth and bottom board: 30-45 cm)");
     v.num(riser_agreement, "riser_agreement_deg", Unit::kDegree, 0, 45,
