@@ -136,7 +136,10 @@ class ManhattanTracker {
     // A riser of a flight, a single step or a curb (mark_risers): the staircase's own direction,
     // which a far wall's cannot overrule.
     bool riser = false;
-    float tread_depth = 0.f;  // m, how far the tread on its top edge is seen to go on beyond it
+    float tread_depth = 0.f;
+    // Grounded and narrower than min_plane_width, with structure_beyond_area of other surfaces
+    // beyond its extension: no wall, whatever its width (min_width()).
+    bool structure_beyond = false;  // m, how far the tread on its top edge is seen to go on beyond it
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
