@@ -330,6 +330,16 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
     EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "open risers' tread fronts: the far wall's frame, " << e.yaw / deg << " deg";
   }
   {
+    // A descent's drop: the floor's edge face, from the floor down 1 m, 1.5 m wide.
+    std::vector<PlaneRegion> drop = {upright_on_floor(T, 2.5f, 0.f, 1.5f, 1.0f, 0.02f)};
+    for (Eigen::Vector3f& p : drop[0].points) p = T.inverse() * (T * p - Eigen::Vector3f(0.f, 1.0f, 0.f));
+    drop[0].centroid = T.inverse() * (T * drop[0].centroid - Eigen::Vector3f(0.f, 1.0f, 0.f));
+    drop[0].offset = -drop[0].normal.dot(drop[0].centroid);
+    const ManhattanEstimate e = frame(drop, cfg);
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "a drop's face: the far wall's frame, " << e.yaw / deg << " deg";
+  }
+  {
     const ManhattanEstimate e = frame(step(T, 2.5f, 0.f, 1.2f, 0.f, 0.17f, 1.0f), cfg);
     ASSERT_TRUE(e.found) << e.why;
     EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "a single step: the far wall's frame, " << e.yaw / deg << " deg";
@@ -617,7 +627,8 @@ TEST(ManhattanFrame, RisersOverruleFarWallsWithRealLikeNoise) {
   const Case views[] = {{"handrails_open_sides_static", 18, 11}, {"handrails_open_sides_static", 9, 4},
                         {"handrails_open_sides_static", 21, 8},  {"single_step_static", 22, 5},
                         {"single_step_static", 6, 2},            {"ascending_short_static", 23, 12},
-                        {"open_risers_static", 7, 12}};
+                        {"open_risers_static", 7, 12},           {"people_static", 20, 5},
+                        {"descending_static", 13, 5}};
   ManhattanConfig no_risers;
   no_risers.riser_agreement = 0.f;
   const synth::SynthOptions real_like = synth::with_real_kinect_noise();
