@@ -136,11 +136,14 @@ TEST(Config, InconsistentPairIsRejected) {
 }
 
 TEST(Config, RiserHeightsAndGoingsMustBeOrdered) {
-  const std::string h = error_of("riser_h", "manhattan:\n  riser_min_height_cm: 25\n  riser_max_height_cm: 20\n");
-  EXPECT_NE(h.find("manhattan.riser_min_height_cm must not exceed manhattan.riser_max_height_cm"), std::string::npos)
+  const std::string h =
+      error_of("riser_h", "manhattan:\n  riser_min_height_cm: 25\n  riser_max_height_cm: 20\n");
+  EXPECT_NE(h.find("manhattan.riser_min_height_cm must not exceed manhattan.riser_max_height_cm"),
+            std::string::npos)
       << h;
   const std::string g = error_of("riser_g", "manhattan:\n  riser_going_min_cm: 70\n");
-  EXPECT_NE(g.find("manhattan.riser_going_min_cm must not exceed manhattan.riser_going_max_cm"), std::string::npos)
+  EXPECT_NE(g.find("manhattan.riser_going_min_cm must not exceed manhattan.riser_going_max_cm"),
+            std::string::npos)
       << g;
 }
 

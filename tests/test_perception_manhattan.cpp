@@ -229,8 +229,8 @@ PlaneRegion floor_between(const Pose& T_floor_camera, float from, float to) {
 /// A step: its riser `width` wide, from `base` to `base + height` above the floor, its foot
 /// `ahead` m in front of the camera, its normal at `yaw` (rad) from z_F facing the camera; and its
 /// tread (or any level surface on its top edge) going `depth` m on beyond it. Points every 2 cm.
-std::vector<PlaneRegion> step(const Pose& T_floor_camera, float ahead, float yaw, float width, float base, float height,
-                              float depth) {
+std::vector<PlaneRegion> step(const Pose& T_floor_camera, float ahead, float yaw, float width, float base,
+                              float height, float depth) {
   const Eigen::Vector3f n_f(-std::sin(yaw), 0.f, -std::cos(yaw));
   const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
   const Eigen::Vector3f foot(0.f, 0.f, ahead);
@@ -305,7 +305,8 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
   auto flight = [&](float yaw) {
     std::vector<PlaneRegion> planes;
     for (int k = 0; k < 3; ++k)
-      for (PlaneRegion& r : step(T, 2.5f + 0.28f * k, yaw, 1.0f, 0.17f * k, 0.17f, 0.28f)) planes.push_back(r);
+      for (PlaneRegion& r : step(T, 2.5f + 0.28f * k, yaw, 1.0f, 0.17f * k, 0.17f, 0.28f))
+        planes.push_back(r);
     return planes;
   };
   const ManhattanConfig cfg;
@@ -314,7 +315,8 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
   {
     const ManhattanEstimate e = frame(flight(0.f), cfg);
     ASSERT_TRUE(e.found) << e.why;
-    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "a flight's risers: the far wall's frame, " << e.yaw / deg << " deg";
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg)
+        << "a flight's risers: the far wall's frame, " << e.yaw / deg << " deg";
     const ManhattanEstimate w = frame(flight(0.f), no_risers);
     ASSERT_TRUE(w.found) << w.why;
     EXPECT_NEAR(w.yaw, wall_yaw, 0.1f * deg) << "without the rule, the wall's frame: the test does not test";
@@ -327,7 +329,8 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
         open.push_back(r);
     const ManhattanEstimate e = frame(open, cfg);
     ASSERT_TRUE(e.found) << e.why;
-    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "open risers' tread fronts: the far wall's frame, " << e.yaw / deg << " deg";
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg)
+        << "open risers' tread fronts: the far wall's frame, " << e.yaw / deg << " deg";
   }
   {
     // A descent's drop: the floor's edge face, from the floor down 1 m, 1.5 m wide.
@@ -337,21 +340,25 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
     drop[0].offset = -drop[0].normal.dot(drop[0].centroid);
     const ManhattanEstimate e = frame(drop, cfg);
     ASSERT_TRUE(e.found) << e.why;
-    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "a drop's face: the far wall's frame, " << e.yaw / deg << " deg";
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg)
+        << "a drop's face: the far wall's frame, " << e.yaw / deg << " deg";
   }
   {
     const ManhattanEstimate e = frame(step(T, 2.5f, 0.f, 1.2f, 0.f, 0.17f, 1.0f), cfg);
     ASSERT_TRUE(e.found) << e.why;
-    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg) << "a single step: the far wall's frame, " << e.yaw / deg << " deg";
+    EXPECT_LT(std::fabs(e.yaw), 0.1f * deg)
+        << "a single step: the far wall's frame, " << e.yaw / deg << " deg";
   }
   {
     const ManhattanEstimate e = frame(flight(20.f * deg), cfg);
     ASSERT_TRUE(e.found) << e.why;
-    EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg) << "a flight 13 deg from the wall, beyond riser_agreement, took the frame";
+    EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg)
+        << "a flight 13 deg from the wall, beyond riser_agreement, took the frame";
   }
   {
     std::vector<PlaneRegion> sofa = step(T, 2.2f, 0.f, 1.6f, 0.f, 0.44f, 0.6f);  // its front and seat
-    for (PlaneRegion& r : step(T, 2.8f, 0.f, 1.6f, 0.44f, 0.19f, 0.2f)) sofa.push_back(r);  // the back's cushion
+    for (PlaneRegion& r : step(T, 2.8f, 0.f, 1.6f, 0.44f, 0.19f, 0.2f))
+      sofa.push_back(r);  // the back's cushion
     const ManhattanEstimate e = frame(sofa, cfg);
     ASSERT_TRUE(e.found) << e.why;
     EXPECT_NEAR(e.yaw, wall_yaw, 0.1f * deg) << "a sofa's cushion on its seat was taken for a riser";
@@ -394,7 +401,8 @@ TEST(ManhattanFrame, NarrowPlaneWithStructureBeyondItIsNoWall) {
   }
   const View v = run_view("people_static", 13, 1, ManhattanConfig{}, synth::with_real_kinect_noise());
   ASSERT_TRUE(v.truth.any_stair_visible());
-  EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f) << "people_static #13 seed 1: frame " << v.yaw_err << " deg off";
+  EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f)
+      << "people_static #13 seed 1: frame " << v.yaw_err << " deg off";
 }
 
 // The compass only says which planes to believe: a plane too narrow to make a frame alone
@@ -624,30 +632,39 @@ TEST(ManhattanFrame, FarNarrowWallsYieldWithRealLikeNoise) {
 // of a sofa and of shelves whose cushion or plinth first passed for a riser (frames 7 and 6 deg
 // off, real-like noise; 4.5 deg, white) are no more than 2 deg off.
 TEST(ManhattanFrame, RisersOverruleFarWallsWithRealLikeNoise) {
-  const Case views[] = {{"handrails_open_sides_static", 18, 11}, {"handrails_open_sides_static", 9, 4},
-                        {"handrails_open_sides_static", 21, 8},  {"single_step_static", 22, 5},
-                        {"single_step_static", 6, 2},            {"ascending_short_static", 23, 12},
-                        {"open_risers_static", 7, 12},           {"people_static", 20, 5},
+  const Case views[] = {{"handrails_open_sides_static", 18, 11},
+                        {"handrails_open_sides_static", 9, 4},
+                        {"handrails_open_sides_static", 21, 8},
+                        {"single_step_static", 22, 5},
+                        {"single_step_static", 6, 2},
+                        {"ascending_short_static", 23, 12},
+                        {"open_risers_static", 7, 12},
+                        {"people_static", 20, 5},
                         {"descending_static", 13, 5}};
   ManhattanConfig no_risers;
   no_risers.riser_agreement = 0.f;
   const synth::SynthOptions real_like = synth::with_real_kinect_noise();
   for (const Case& c : views) {
-    const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+    const std::string name =
+        std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
     const View v = run_view(c.preset, c.index, c.seed, ManhattanConfig{}, real_like);
     ASSERT_TRUE(v.truth.any_stair_visible()) << name;
     EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
     EXPECT_LE(v.yaw_err, 2.f) << name;
     const View w = run_view(c.preset, c.index, c.seed, no_risers, real_like);
-    EXPECT_TRUE(w.yaw_err < 0.f || w.yaw_err > 2.f) << name << ": right without the rule, the test does not test";
+    EXPECT_TRUE(w.yaw_err < 0.f || w.yaw_err > 2.f)
+        << name << ": right without the rule, the test does not test";
   }
   const struct {
     Case c;
     bool real_like;
-  } furniture[] = {{{"sofa_static", 1, kSuiteSeed}, true}, {{"shelves_static", 20, kSuiteSeed}, true},
-                   {{"sofa_static", 3, 10}, true},         {{"shelves_static", 16, 2}, false}};
+  } furniture[] = {{{"sofa_static", 1, kSuiteSeed}, true},
+                   {{"shelves_static", 20, kSuiteSeed}, true},
+                   {{"sofa_static", 3, 10}, true},
+                   {{"shelves_static", 16, 2}, false}};
   for (const auto& f : furniture) {
-    const View v = run_view(f.c.preset, f.c.index, f.c.seed, ManhattanConfig{}, f.real_like ? real_like : synth::SynthOptions{});
+    const View v = run_view(f.c.preset, f.c.index, f.c.seed, ManhattanConfig{},
+                            f.real_like ? real_like : synth::SynthOptions{});
     EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f)
         << f.c.preset << " #" << f.c.index << " seed " << f.c.seed << ": frame " << v.yaw_err << " deg off";
   }

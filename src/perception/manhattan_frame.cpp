@@ -361,9 +361,10 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   if (frame.found && cfg_.riser_agreement > 0.f) {
     bool near_wall = false;
     for (const Vote& v : votes)
-      near_wall = near_wall || (!v.inside && !v.tilted && !v.clipped && !v.sloped_band && v.range < cfg_.far_wall_range &&
-                                v.width >= min_width(v, /*bounding_only=*/true) &&
-                                std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
+      near_wall =
+          near_wall || (!v.inside && !v.tilted && !v.clipped && !v.sloped_band &&
+                        v.range < cfg_.far_wall_range && v.width >= min_width(v, /*bounding_only=*/true) &&
+                        std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
     if (!near_wall) {
       const ManhattanEstimate risers = solve(votes, total_area, Voters::kRisers);
       if (risers.found && std::fabs(wrap_quarter(risers.yaw - frame.yaw)) <= cfg_.riser_agreement) {
@@ -425,7 +426,8 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   vetoes.clear();
   // Risers agreeing with the frame: far walls and walls at the cut-off cannot veto it (see above).
   for (const Vote& v : votes)
-    riser_frame = riser_frame || (v.riser && std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
+    riser_frame =
+        riser_frame || (v.riser && std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
   // The samples beyond a plane are counted only for the few planes this can concern (all pairs cost
   // 0.3 ms on a kitchen view of 100 regions).
   for (const Vote& vf : votes) {
@@ -558,7 +560,8 @@ void ManhattanTracker::mark_risers(const std::vector<PlaneRegion>& regions, cons
   for (Vote& v : votes) {
     v.riser = false;
     v.tread_depth = 0.f;
-    if (!v.has_side || v.tilted || v.clipped || v.sloped_band || v.top - v.base > cfg_.riser_max_height) continue;
+    if (!v.has_side || v.tilted || v.clipped || v.sloped_band || v.top - v.base > cfg_.riser_max_height)
+      continue;
     for (std::size_t k = 0; k < regions.size(); ++k) {
       const PlaneRegion& r = regions[k];
       if (r.points.empty() || std::fabs((R * r.normal).y()) < cos_tol) continue;
@@ -605,14 +608,16 @@ void ManhattanTracker::mark_risers(const std::vector<PlaneRegion>& regions, cons
   }
   for (std::size_t i = 0; i < votes.size(); ++i) {
     Vote& v = votes[i];
-    const bool single = std::fabs(v.base) <= cfg_.floor_beyond_height && v.top - v.base >= cfg_.riser_min_height &&
-                        v.width >= cfg_.single_riser_min_width && v.tread_depth >= cfg_.single_riser_min_depth;
+    const bool single = std::fabs(v.base) <= cfg_.floor_beyond_height &&
+                        v.top - v.base >= cfg_.riser_min_height && v.width >= cfg_.single_riser_min_width &&
+                        v.tread_depth >= cfg_.single_riser_min_depth;
     // The face of a drop (the floor's edge over a descent, a stairwell's side): its top edge at the
     // floor's height, going down a riser or more, as wide as a wall. Furniture stands on a floor; it
     // does not hang from the user's. (Real-like seeds 1-12: 2 more views right, people #20 seed 5
     // among them, 6.1 deg off before by a far wall's frame; white noise and the kitchen unchanged.)
-    const bool drop = !v.tilted && !v.clipped && !v.sloped_band && std::fabs(v.top) <= cfg_.floor_beyond_height &&
-                      v.base < -cfg_.riser_min_height && v.width >= cfg_.min_plane_width;
+    const bool drop = !v.tilted && !v.clipped && !v.sloped_band &&
+                      std::fabs(v.top) <= cfg_.floor_beyond_height && v.base < -cfg_.riser_min_height &&
+                      v.width >= cfg_.min_plane_width;
     v.riser = (v.riser && (stacked[i] || single)) || drop;
   }
 }

@@ -133,8 +133,8 @@ class ManhattanTracker {
     float range = 0.f;  // m, its centroid's distance from the camera
     float base = 0.f;   // m, its lowest point's height above the floor
     float top = 0.f;    // m, its highest point's height above the floor
-    // A riser of a flight, a single step or a curb, or a drop's face (mark_risers): the staircase's own direction,
-    // which a far wall's cannot overrule.
+    // A riser of a flight, a single step or a curb, or a drop's face (mark_risers): the staircase's own
+    // direction, which a far wall's cannot overrule.
     bool riser = false;
     float tread_depth = 0.f;
     // Grounded and narrower than min_plane_width, with structure_beyond_area of other surfaces
