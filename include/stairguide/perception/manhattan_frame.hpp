@@ -136,10 +136,10 @@ class ManhattanTracker {
     // A riser of a flight, a single step or a curb, or a drop's face (mark_risers): the staircase's own
     // direction, which a far wall's cannot overrule.
     bool riser = false;
-    float tread_depth = 0.f;
+    float tread_depth = 0.f;  // m, how far the tread on its top edge is seen to go on beyond it
     // Grounded and narrower than min_plane_width, with structure_beyond_area of other surfaces
-    // beyond its extension: no wall, whatever its width (min_width()).
-    bool structure_beyond = false;  // m, how far the tread on its top edge is seen to go on beyond it
+    // beyond its extension: no wall strip, so it makes no walls' frame alone (min_width()).
+    bool structure_beyond = false;
   };
   struct StructureSample {
     float x, z, area;  // floor frame, m; m^2 it stands for
