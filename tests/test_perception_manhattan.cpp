@@ -226,6 +226,16 @@ PlaneRegion floor_between(const Pose& T_floor_camera, float from, float to) {
                    Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitZ(), 4.f, to - from, 0.05f);
 }
 
+/// `r` moved `down` m straight down (a plane standing below the floor's level).
+PlaneRegion lowered(PlaneRegion r, const Pose& T_floor_camera, float down) {
+  const Pose T_cf = T_floor_camera.inverse();
+  const Eigen::Vector3f d(0.f, down, 0.f);
+  for (Eigen::Vector3f& p : r.points) p = T_cf * (T_floor_camera * p - d);
+  r.centroid = T_cf * (T_floor_camera * r.centroid - d);
+  r.offset = -r.normal.dot(r.centroid);
+  return r;
+}
+
 /// A step: its riser `width` wide, from `base` to `base + height` above the floor, its foot
 /// `ahead` m in front of the camera, its normal at `yaw` (rad) from z_F facing the camera; and its
 /// tread (or any level surface on its top edge) going `depth` m on beyond it. Points every 2 cm.
@@ -334,11 +344,7 @@ TEST(ManhattanFrame, RisersOverruleFarWalls) {
   }
   {
     // A descent's drop: the floor's edge face, from the floor down 1 m, 1.5 m wide.
-    std::vector<PlaneRegion> drop = {upright_on_floor(T, 2.5f, 0.f, 1.5f, 1.0f, 0.02f)};
-    for (Eigen::Vector3f& p : drop[0].points) p = T.inverse() * (T * p - Eigen::Vector3f(0.f, 1.0f, 0.f));
-    drop[0].centroid = T.inverse() * (T * drop[0].centroid - Eigen::Vector3f(0.f, 1.0f, 0.f));
-    drop[0].offset = -drop[0].normal.dot(drop[0].centroid);
-    const ManhattanEstimate e = frame(drop, cfg);
+    const ManhattanEstimate e = frame({lowered(upright_on_floor(T, 2.5f, 0.f, 1.5f, 1.0f, 0.02f), T, 1.0f)}, cfg);
     ASSERT_TRUE(e.found) << e.why;
     EXPECT_LT(std::fabs(e.yaw), 0.1f * deg)
         << "a drop's face: the far wall's frame, " << e.yaw / deg << " deg";
@@ -383,10 +389,7 @@ TEST(ManhattanFrame, NarrowPlaneWithStructureBeyondItIsNoWall) {
   const PlaneRegion floor = rectangle(T, Eigen::Vector3f(0.f, 0.f, 1.4f), Eigen::Vector3f::UnitY(),
                                       Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitZ(), 1.2f, 1.2f, 0.05f);
   const PlaneRegion shins = upright_on_floor(T, 2.6f, person, 0.22f, 0.44f, 0.02f);
-  PlaneRegion wall_below = upright_on_floor(T, 5.0f, 0.f, 1.0f, 0.6f, 0.02f);
-  for (Eigen::Vector3f& p : wall_below.points) p = T.inverse() * (T * p - Eigen::Vector3f(0.f, 0.9f, 0.f));
-  wall_below.centroid = T.inverse() * (T * wall_below.centroid - Eigen::Vector3f(0.f, 0.9f, 0.f));
-  wall_below.offset = -wall_below.normal.dot(wall_below.centroid);
+  const PlaneRegion wall_below = lowered(upright_on_floor(T, 5.0f, 0.f, 1.0f, 0.6f, 0.02f), T, 0.9f);
   {
     ManhattanTracker m;
     const ManhattanEstimate e = m.estimate({floor, shins, wall_below}, T);

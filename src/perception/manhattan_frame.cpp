@@ -357,15 +357,18 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   // in view 21 -> 12 (their risers within 0.35 deg, the far walls 2.5 to 7 deg off), 7 views of a
   // staircase that a far wall's veto left without a frame now have one; white noise: 2 more views
   // with a frame, none changed otherwise (ManhattanFrame.RisersOverruleFarWalls*).
+  // Does a wall that `is_far` does not set aside, wide enough to make the walls' frame, agree with it?
+  auto near_wall_agrees = [&](auto is_far) {
+    for (const Vote& v : votes)
+      if (!v.inside && !v.tilted && !v.clipped && !v.sloped_band && !is_far(v) &&
+          v.width >= min_width(v, /*bounding_only=*/true) &&
+          std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance)
+        return true;
+    return false;
+  };
   bool riser_frame = false;
   if (frame.found && cfg_.riser_agreement > 0.f) {
-    bool near_wall = false;
-    for (const Vote& v : votes)
-      near_wall =
-          near_wall || (!v.inside && !v.tilted && !v.clipped && !v.sloped_band &&
-                        v.range < cfg_.far_wall_range && v.width >= min_width(v, /*bounding_only=*/true) &&
-                        std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
-    if (!near_wall) {
+    if (!near_wall_agrees([&](const Vote& v) { return v.range >= cfg_.far_wall_range; })) {
       const ManhattanEstimate risers = solve(votes, total_area, Voters::kRisers);
       if (risers.found && std::fabs(wrap_quarter(risers.yaw - frame.yaw)) <= cfg_.riser_agreement) {
         frame = risers;
@@ -386,12 +389,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   // furniture turned 2 to 4 deg now gives its frame, that far off: on seeds 1-20, 6 more frames
   // off with a wall in view of 4815 views, none with a staircase in view.)
   if (frame.found && !riser_frame && cfg_.far_wall_agreement > 0.f) {
-    bool near_wall = false;
-    for (const Vote& v : votes)
-      near_wall = near_wall || (!v.inside && !v.tilted && !v.clipped && !v.sloped_band && !v.far &&
-                                v.width >= min_width(v, /*bounding_only=*/true) &&
-                                std::fabs(wrap_quarter(v.a - frame.yaw)) <= cfg_.cluster_tolerance);
-    if (!near_wall) {
+    if (!near_wall_agrees([](const Vote& v) { return v.far; })) {
       const ManhattanEstimate all = solve(votes, total_area, Voters::kAll);
       if (all.found && std::fabs(wrap_quarter(all.yaw - frame.yaw)) <= cfg_.far_wall_agreement) {
         frame = all;
