@@ -758,8 +758,10 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
 // issue's figures: what they become when the synthetic sensor is as unkind as the real one,
 // held as regression floors. Measured on the default seed (white noise in brackets): floor
 // 427/428 (427/428), wrong plane 0 (0), treads 512/514 (514/514, two found 1-2 cm off in
-// height), mixed 0 (0), Manhattan 200/222 (217/222), 1 frame more than 2 deg off with a staircase
-// in view (0), 11 with a wall in view (0).
+// height), mixed 0 (0), Manhattan 203/222 (217/222), no frame more than 2 deg off with a staircase
+// in view (0), 10 with a wall in view (0). (200/222, 1 and 11 before a flat riser with a noisy patch
+// at its edge was no longer taken for a facet of a curved surface: single_step #9 and #12 had no
+// vertical plane; PerceptionRegions.FlatRiserWithANoisyPatchAtItsEdgeIsNoCurvedFacet.)
 TEST(PerceptionPresetRealLikeNoise, FiguresOfIssue3) {
   Totals sum;  // not the suite's Totals::get(): these views are not issue 3's figures
   const char* seed = getenv("SG_SEED");
@@ -780,9 +782,9 @@ TEST(PerceptionPresetRealLikeNoise, FiguresOfIssue3) {
   EXPECT_EQ(A.floor_wrong_plane, 0);
   EXPECT_GE(A.treads_ok, 512) << "measured 512/514";
   EXPECT_EQ(A.mixed, 0);
-  EXPECT_GE(A.manhattan_ok, 200) << "measured 200/222";
-  EXPECT_LE(A.manhattan_wrong, 1) << "measured 1 (people #2, 2.12 deg)";
-  EXPECT_LE(A.manhattan_off, 11) << "measured 11";
+  EXPECT_GE(A.manhattan_ok, 203) << "measured 203/222";
+  EXPECT_EQ(A.manhattan_wrong, 0) << "measured 0";
+  EXPECT_LE(A.manhattan_off, 10) << "measured 10";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPresets, PerceptionPreset, ::testing::ValuesIn([] {

@@ -4,8 +4,10 @@
 // vertical left, right, front), and a curved pole left to the obstacle clusters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <string>
 
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/capture/synthetic_builders.hpp"
@@ -154,6 +156,49 @@ TEST(PerceptionRegions, GeometryAndClassesOnAKnownScene) {
     pole_cluster = pole_cluster || std::hypot(c.x() + 0.8f, c.y() - 1.4f) < 0.2f;
   }
   EXPECT_TRUE(pole_cluster) << "the pole is an obstacle cluster";
+}
+
+// With the real-like noise (correlated over 2 and 10 px), a staircase's first riser at the image's
+// top edge, 3000 to 6000 px, met a patch of about 130 px bent 14 deg at its edge: the curved
+// surfaces' test took it for a facet of one and gave it to the obstacles, and these views had no
+// vertical plane at all. Facets of one curve are of a size (SegmentationConfig::
+// curved_facet_size_ratio): the riser is a region again. (People still come out as obstacles:
+// PerceptionRealData.BigPlanesWholeCurvedSurfacesObstacles.)
+TEST(PerceptionRegions, FlatRiserWithANoisyPatchAtItsEdgeIsNoCurvedFacet) {
+  const struct {
+    const char* preset;
+    long index;
+    std::uint32_t seed;
+  } views[] = {{"single_step_static", 9, 20261123u},
+               {"single_step_static", 12, 20261123u},
+               {"rotated_static", 6, 12},
+               {"handrails_open_sides_static", 6, 5}};
+  SegmentationConfig old_rule;
+  old_rule.curved_facet_size_ratio = 0.f;
+  // The biggest region upright in the world (within 10 deg), in pixels.
+  auto biggest_upright = [](const SceneResult& sc, const FrameTruth& t) {
+    int best = 0;
+    for (const PlaneRegion& r : sc.regions)
+      if (std::fabs((t.T_world_camera.linear() * r.normal).z()) < std::sin(0.1745f))
+        best = std::max(best, r.pixel_count);
+    return best;
+  };
+  for (const auto& v : views) {
+    const std::string name =
+        std::string(v.preset) + " #" + std::to_string(v.index) + " seed " + std::to_string(v.seed);
+    RgbdFrame frame;
+    FrameTruth truth;
+    render_preset_frame(v.preset, v.index, v.seed, with_real_kinect_noise(), frame, truth);
+    ASSERT_GE(truth.wall_or_riser_pixels, 3000) << name;
+    SceneResult sc;
+    Perception P;
+    P.process(frame, sc);
+    EXPECT_GE(biggest_upright(sc, truth), truth.wall_or_riser_pixels / 2) << name;
+    Perception P_old(old_rule);
+    P_old.process(frame, sc);
+    EXPECT_LT(biggest_upright(sc, truth), truth.wall_or_riser_pixels / 2)
+        << name << ": the riser was a region before too, the test does not test";
+  }
 }
 
 // Paper 3.2.2: "throughout iterations F_T_M is recalculated but maintaining the orientation

@@ -78,6 +78,7 @@ struct SegmentationConfig {
   int strip_length_px = 8;           ///< px, columns of the 2-row windows seeding thin strips on dominant directions (0: off)
   float curved_tile_max_area = 0.15f;  ///< m^2, regions smaller than this, bent smoothly into their neighbours, are tiles of a curved surface (0: off)
   float curved_bend_max_angle = 0.6981317f;  ///< rad, a smooth (depth-continuous) seam between two regions at most this angle apart is a bend (40 deg)
+  float curved_facet_size_ratio = 8.f;  ///< a region bends like a facet only into neighbours at least 1/ratio its area (0: any neighbour)
 
   template <class V> void visit(V& v) {
     v.num(voxel_size, "voxel_size_cm", Unit::kCentimetre, 0.5, 20, "voxel grid edge (paper: 3-4 cm)");
@@ -110,6 +111,9 @@ struct SegmentationConfig {
           "is a facet of a curved surface (a person, a bag) and goes to the obstacles; 0 = off");
     v.num(curved_bend_max_angle, "curved_bend_max_angle_deg", Unit::kDegree, 1, 89,
           "largest angle between two regions meeting without a depth jump that counts as a bend of one curved surface");
+    v.num(curved_facet_size_ratio, "curved_facet_size_ratio", Unit::kNone, 0, 1000,
+          "facets of one curved surface are of a size: a region bends into a neighbour as a facet only when it is at most "
+          "this many times the neighbour's area (a flat riser meeting a small noisy patch is no facet); 0 = any size");
   }
 };
 
