@@ -398,6 +398,42 @@ TEST(ManhattanFrame, NarrowPlaneWithStructureBeyondItIsNoWall) {
       << "people_static #13 seed 1: frame " << v.yaw_err << " deg off";
 }
 
+// Furniture hangs above the floor inside the room (ManhattanConfig::hanging_min_height): a bench's
+// apron 1.3 m wide and 6 cm tall under its seat, turned 12 deg against the room, and the edges of
+// two desks 0.9 m wide, one row behind the other, make no frame (a frame 12 deg off before, with nothing
+// else in view to say so). Open risers' tread fronts, the lowest standing on the floor, still make a
+// frame in a pair with an upper one (two treads between them unseen: no flight to mark as risers).
+TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
+  const Pose T = level_camera();
+  const float deg = 3.14159265f / 180.f;
+  const float turned = 12.f * deg;
+  const PlaneRegion floor = floor_between(T, 0.8f, 4.4f);  // beyond the furniture: it stands inside
+  std::vector<PlaneRegion> bench = step(T, 2.2f, turned, 1.3f, 0.41f, 0.06f, 0.4f);
+  bench.push_back(floor);
+  std::vector<PlaneRegion> desks = step(T, 2.0f, turned, 0.9f, 0.68f, 0.04f, 0.6f);
+  for (PlaneRegion& r : step(T, 2.8f, turned, 0.9f, 0.68f, 0.04f, 0.6f)) desks.push_back(r);
+  desks.push_back(floor);
+  ManhattanConfig off;
+  off.hanging_min_height = 0.f;
+  for (const auto& [planes, what] :
+       {std::make_pair(bench, "a bench's apron"), std::make_pair(desks, "two desks' edges")}) {
+    ManhattanTracker m;
+    const ManhattanEstimate e = m.estimate(planes, T);
+    EXPECT_FALSE(e.found) << what << ": frame " << e.yaw / deg << " deg";
+    ManhattanTracker m_off(off);
+    const ManhattanEstimate e_off = m_off.estimate(planes, T);
+    ASSERT_TRUE(e_off.found) << what << " without the rule (or the test does not test): " << e_off.why;
+    EXPECT_NEAR(e_off.yaw, turned, 0.1f * deg) << what << " without the rule";
+  }
+  std::vector<PlaneRegion> open = step(T, 2.5f, 0.f, 0.6f, 0.12f, 0.05f, 0.25f);
+  for (PlaneRegion& r : step(T, 3.06f, 0.f, 0.6f, 0.46f, 0.05f, 0.25f)) open.push_back(r);
+  open.push_back(floor);
+  ManhattanTracker m;
+  const ManhattanEstimate e = m.estimate(open, T);
+  ASSERT_TRUE(e.found) << "open risers' tread fronts: " << e.why;
+  EXPECT_NEAR(e.yaw, 0.f, 0.1f * deg);
+}
+
 // The compass only says which planes to believe: a plane too narrow to make a frame alone
 // (0.3 m, floating) makes one when the image edges agree with it within compass_agreement (the
 // frame is the plane's yaw, not the compass's), and none when they disagree by more, when the

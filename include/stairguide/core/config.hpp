@@ -248,6 +248,7 @@ struct ManhattanConfig {
   float single_riser_min_width = 0.8f;  ///< m, one standing on the floor is a riser (a single step, a curb) when this wide ...
   float single_riser_min_depth = 0.6f;  ///< m, ... and its tread is seen to go on this far beyond it
   float riser_agreement = 0.17453293f;  ///< rad, risers make the frame over far walls within this of them, and far walls cannot veto it (10 deg); 0: never
+  float hanging_min_height = 0.22f;     ///< m, a plane with floor beyond it whose lowest point is this high (furniture, people) makes no frame alone (0: off)
   float structure_beyond_area = 0.02f;  ///< m^2, other surfaces this large beyond a vertical plane make it no wall; a wall this large beyond a frame's plane may veto it ...
   float veto_min_width = 0.2f;          ///< m, ... when at least this wide
   float sliver_width = 0.15f;           ///< m, a plane at the depth cut-off narrower than this (in-plane, narrowest) is a sliver ...
@@ -320,6 +321,10 @@ struct ManhattanConfig {
           "the risers' frame is the staircase's own: where only walls far_wall_range_cm away or at the depth cut-off "
           "make the walls' frame, the risers' frame within this of it is taken, and such walls cannot veto a frame "
           "that risers agree with; 0: risers have no such standing");
+    v.num(hanging_min_height, "hanging_min_height_cm", Unit::kCentimetre, 0, 300,
+          "a vertical plane with floor beyond it (not a riser) whose lowest point is this high above the floor hangs "
+          "there as furniture or people do (a seat's apron, a chair's back, a table's edge): it votes, but makes no "
+          "frame alone, nor with another such plane; 0 = off");
     v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
           "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
           "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "

@@ -11,7 +11,9 @@
 /// in view make none.
 /// Planes with floor beyond them (furniture, risers, people: they stand inside the room) vote only
 /// when the others (walls, which bound the floor) make no frame; a wall standing on the floor is
-/// trusted from min_bounding_width. Planes clipped by the depth cut-off cannot make that frame;
+/// trusted from min_bounding_width. Such a plane hanging above the floor (hanging_min_height: a
+/// seat's apron, a chair's back, a table's edge) makes no frame alone, nor in a pair with another
+/// hanging one. Planes clipped by the depth cut-off cannot make that frame;
 /// their yaw is their plane's held upright, fitted on their readings clear of the cut-off's noise
 /// band when at least half of them are (fit_upright_normal_clear_of_cutoff).
 /// A wall (no surface at all beyond it, standing on the floor or reaching the cut-off, at least
@@ -152,6 +154,9 @@ class ManhattanTracker {
   float disagree_tolerance(const Vote& v) const;
   /// Width from which an agreeing plane makes the frame trusted on its own.
   float min_width(const Vote& v, bool bounding_only) const;
+  /// Inside the room and hanging above the floor (hanging_min_height): furniture or a person, never
+  /// the plane that makes a frame alone, nor one of a pair with another such plane.
+  bool hangs(const Vote& v) const;
   /// Which votes solve() counts: the planes that bound the room, all of them, or the risers.
   enum class Voters { kBounding, kAll, kRisers };
   ManhattanEstimate solve(const std::vector<Vote>& votes, float total_area, Voters voters);
