@@ -400,9 +400,10 @@ TEST(ManhattanFrame, NarrowPlaneWithStructureBeyondItIsNoWall) {
 
 // Furniture hangs above the floor inside the room (ManhattanConfig::hanging_min_height): a bench's
 // apron 1.3 m wide and 6 cm tall under its seat, turned 12 deg against the room, and the edges of
-// two desks 0.9 m wide, one row behind the other, make no frame (a frame 12 deg off before, with nothing
-// else in view to say so). Open risers' tread fronts, the lowest standing on the floor, still make a
-// frame in a pair with an upper one (two treads between them unseen: no flight to mark as risers).
+// two desks 0.9 m wide, one row behind the other, make no frame (a frame 12 deg off before, with
+// nothing else in view to say so). Open risers' tread fronts 0.6 m wide, the lowest standing on the
+// floor, still make a frame in a pair with an upper one (two treads between them unseen: no flight
+// to mark as risers).
 TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
   const Pose T = level_camera();
   const float deg = 3.14159265f / 180.f;
