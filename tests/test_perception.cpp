@@ -759,9 +759,11 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
 // held as regression floors. Measured on the default seed (white noise in brackets): floor
 // 427/428 (427/428), wrong plane 0 (0), treads 512/514 (514/514, two found 1-2 cm off in
 // height), mixed 0 (0), Manhattan 203/222 (217/222), no frame more than 2 deg off with a staircase
-// in view (0), 10 with a wall in view (0). (200/222, 1 and 11 before a flat riser with a noisy patch
+// in view (0), 9 with a wall in view (0). (200/222, 1 and 11 before a flat riser with a noisy patch
 // at its edge was no longer taken for a facet of a curved surface: single_step #9 and #12 had no
-// vertical plane; PerceptionRegions.FlatRiserWithANoisyPatchAtItsEdgeIsNoCurvedFacet.)
+// vertical plane; PerceptionRegions.FlatRiserWithANoisyPatchAtItsEdgeIsNoCurvedFacet. 10 before a
+// table's edge confirmed by the image edges no longer made the frame alone, table #15 2.12 deg off:
+// ManhattanConfig::hanging_min_height.)
 TEST(PerceptionPresetRealLikeNoise, FiguresOfIssue3) {
   Totals sum;  // not the suite's Totals::get(): these views are not issue 3's figures
   const char* seed = getenv("SG_SEED");
@@ -784,7 +786,7 @@ TEST(PerceptionPresetRealLikeNoise, FiguresOfIssue3) {
   EXPECT_EQ(A.mixed, 0);
   EXPECT_GE(A.manhattan_ok, 203) << "measured 203/222";
   EXPECT_EQ(A.manhattan_wrong, 0) << "measured 0";
-  EXPECT_LE(A.manhattan_off, 10) << "measured 10";
+  EXPECT_LE(A.manhattan_off, 9) << "measured 9";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPresets, PerceptionPreset, ::testing::ValuesIn([] {

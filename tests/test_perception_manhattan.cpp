@@ -403,7 +403,7 @@ TEST(ManhattanFrame, NarrowPlaneWithStructureBeyondItIsNoWall) {
 // two desks 0.9 m wide, one row behind the other, make no frame (a frame 12 deg off before, with
 // nothing else in view to say so). Open risers' tread fronts 0.6 m wide, the lowest standing on the
 // floor, still make a frame in a pair with an upper one (two treads between them unseen: no flight
-// to mark as risers).
+// to mark as risers). The image edges confirming the furniture change nothing.
 TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
   const Pose T = level_camera();
   const float deg = 3.14159265f / 180.f;
@@ -421,6 +421,18 @@ TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
     ManhattanTracker m;
     const ManhattanEstimate e = m.estimate(planes, T);
     EXPECT_FALSE(e.found) << what << ": frame " << e.yaw / deg << " deg";
+    // The image edges agreeing with the furniture (its own edges) confirm nothing more.
+    const auto edges = [&]() {
+      EdgeCompassResult c;
+      c.valid = true;
+      c.yaw = turned;
+      c.support = 0.5f;
+      c.weight = 1.f;
+      return c;
+    };
+    ManhattanTracker m_edges;
+    const ManhattanEstimate e_edges = m_edges.estimate(planes, T, edges);
+    EXPECT_FALSE(e_edges.found) << what << ", its edges confirming it: frame " << e_edges.yaw / deg << " deg";
     ManhattanTracker m_off(off);
     const ManhattanEstimate e_off = m_off.estimate(planes, T);
     ASSERT_TRUE(e_off.found) << what << " without the rule (or the test does not test): " << e_off.why;
