@@ -3,13 +3,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "manhattan_test_util.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/perception.hpp"
-#include "manhattan_test_util.hpp"
 
 using namespace stairguide;
 
@@ -172,6 +173,19 @@ TEST(ManhattanFrame, SmallPlanesConfirmedByTheImageEdges) {
 }
 
 namespace {
+
+/// Image edges (edge_compass.hpp) whose direction is `yaw` (rad) with `support`, for
+/// ManhattanTracker::estimate's compass.
+std::function<EdgeCompassResult()> compass_at(float yaw, float support = 0.4f) {
+  return [yaw, support]() {
+    EdgeCompassResult c;
+    c.valid = true;
+    c.yaw = yaw;
+    c.support = support;
+    c.weight = 1.f;
+    return c;
+  };
+}
 
 /// A level camera 1.3 m above the floor (camera x right, y down, z ahead; floor x left, y up).
 Pose level_camera() {
@@ -422,16 +436,8 @@ TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
     const ManhattanEstimate e = m.estimate(planes, T);
     EXPECT_FALSE(e.found) << what << ": frame " << e.yaw / deg << " deg";
     // The image edges agreeing with the furniture (its own edges) confirm nothing more.
-    const auto edges = [&]() {
-      EdgeCompassResult c;
-      c.valid = true;
-      c.yaw = turned;
-      c.support = 0.5f;
-      c.weight = 1.f;
-      return c;
-    };
     ManhattanTracker m_edges;
-    const ManhattanEstimate e_edges = m_edges.estimate(planes, T, edges);
+    const ManhattanEstimate e_edges = m_edges.estimate(planes, T, compass_at(turned));
     EXPECT_FALSE(e_edges.found) << what << ", its edges confirming it: frame " << e_edges.yaw / deg << " deg";
     ManhattanTracker m_off(off);
     const ManhattanEstimate e_off = m_off.estimate(planes, T);
@@ -454,16 +460,6 @@ TEST(ManhattanFrame, HangingFurnitureMakesNoFrameAlone) {
 TEST(ManhattanFrame, CompassConfirmsOnlyAgreeingPlanes) {
   const Pose T = level_camera();
   const float yaw = 0.3f;  // 17 deg
-  auto compass_at = [](float y, float support) {
-    return [y, support]() {
-      EdgeCompassResult c;
-      c.valid = true;
-      c.yaw = y;
-      c.support = support;
-      c.weight = 1.f;
-      return c;
-    };
-  };
   const ManhattanConfig cfg;
   {
     ManhattanTracker m(cfg);
@@ -502,16 +498,6 @@ TEST(ManhattanFrame, CompassConfirmsOnlyAgreeingPlanes) {
 TEST(ManhattanFrame, TiltedLevelBandJoinsOnlyConfirmedFrames) {
   const Pose T = level_camera();
   const float yaw = -0.2f;
-  auto compass_at = [](float y) {
-    return [y]() {
-      EdgeCompassResult c;
-      c.valid = true;
-      c.yaw = y;
-      c.support = 0.4f;
-      c.weight = 1.f;
-      return c;
-    };
-  };
   const ManhattanConfig cfg;
   {
     ManhattanTracker m(cfg);
