@@ -530,10 +530,10 @@ float ManhattanTracker::disagree_tolerance(const Vote& v) const {
 // turned against the room (a bench's apron 1.3 m wide and 6 cm tall made frames 2.5-6 deg off with
 // a wall in view), so it votes, joins a frame and makes one in a pair with a plane that does not
 // hang (open risers' tread fronts, the lowest on the floor), but makes none alone nor with another
-// hanging plane. Walls have no floor beyond them, and a flight's risers, which
-// hang too, are marked as such (mark_risers). On seeds 1-20 of the static presets (white noise)
-// and 1-12 (real-like), with segmentation's curved_facet_size_ratio: frames off with a wall in
-// view 41 -> 34 and 113 -> 102 (no view more), right frames 4599 -> 4600 and 2666 -> 2667.
+// hanging plane. Walls have no floor beyond them, and a flight's risers, which hang too, are marked
+// as such (mark_risers). On seeds 1-20 of the static presets (white noise) and 1-12 (real-like),
+// with segmentation's curved_facet_size_ratio: frames off with a wall in view 41 -> 34 and
+// 113 -> 102 (no view more), right frames 4599 -> 4600 and 2666 -> 2667.
 bool ManhattanTracker::hangs(const Vote& v) const {
   return cfg_.hanging_min_height > 0.f && v.inside && !v.riser && v.base > cfg_.hanging_min_height;
 }
