@@ -266,6 +266,8 @@ struct ManhattanConfig {
   float compass_min_support = 0.2f;     ///< share of the image edges' votes at their peak direction (edge_compass.hpp) for it to count; 1: never asked
   float compass_agreement = 0.03490659f;  ///< rad, planes within this of that direction (modulo 90 deg) ... (2 deg)
   float compass_min_width = 0.2f;       ///< m, ... make the frame when one of them is this wide, even if too narrow or small to be trusted alone
+  float compass_veto_min_support = 0.06f;  ///< share of the edges' votes at their peak for them to give a frame that narrow walls veto (1: never) ...
+  float compass_veto_agreement = 0.10471976f;  ///< rad, ... when within this of the widest vetoing wall (6 deg; 0: never)
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -368,6 +370,12 @@ struct ManhattanConfig {
           "vertical planes within this of that direction (modulo 90 deg) ...");
     v.num(compass_min_width, "compass_min_width_cm", Unit::kCentimetre, 0, 1000,
           "... make the frame when one of them is this wide, although too narrow or too small to be trusted alone");
+    v.num(compass_veto_min_support, "compass_veto_min_support", Unit::kNone, 0, 1,
+          "where walls too narrow to make a frame veto the furniture's (structure_beyond_area), the image edges' "
+          "direction with this share of their votes at its peak gives the frame ...; 1: never");
+    v.num(compass_veto_agreement, "compass_veto_agreement_deg", Unit::kDegree, 0, 45,
+          "... when it agrees within this with the widest vetoing wall (modulo 90 deg) and not with the furniture's "
+          "frame; 0: never");
     v.flag(without_floor, "without_floor",
            "with no floor found, measure the frame about the vertical of a floor-like plane the floor's checks refused "
            "(a tread, a seat: which level the user stands on is in doubt, which way is up is not)");

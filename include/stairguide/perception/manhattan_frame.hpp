@@ -21,7 +21,9 @@
 /// half of a smaller one) and disagreeing with the frame modulo 90 degrees vetoes it: no frame
 /// (`why` says so) rather than the frame of furniture turned against the room; a sliver at the
 /// cut-off disagrees only beyond clipped_disagreement. When the widest vetoing wall is
-/// min_plane_width wide, the walls agreeing with it give the frame instead. A thin band along a
+/// min_plane_width wide, the walls agreeing with it give the frame instead; when it is narrower,
+/// the image edges' direction agreeing with it (compass_veto_*) and not with the vetoed frame gives
+/// the frame. A thin band along a
 /// sloping axis (a handrail beside a flight) votes but cannot make a frame: its yaw turns with its
 /// plane about that axis.
 /// When the planes alone make no trusted frame, the image edges' direction (edge_compass.hpp, an
