@@ -10,6 +10,14 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 constexpr float kHalfPi = 0.5f * kPi;
 float wrap_quarter(float a) { return manhattan_wrap(a); }
+// `e` found at `yaw` (its k_M branch already kept), with `agree` m^2 of vertical planes agreeing.
+void set_frame(ManhattanEstimate& e, float yaw, float agree, float total_area) {
+  e.found = true;
+  e.yaw = yaw;
+  e.T_manhattan_floor = manhattan_pose_from_yaw(yaw);
+  e.vertical_area = agree;
+  e.fraction = total_area > 0.f ? agree / total_area : 0.f;
+}
 }  // namespace
 
 Pose manhattan_pose_from_yaw(float yaw) {
@@ -409,7 +417,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   if (!frame.found && compass && cfg_.compass_min_support < 1.f) {
     // The planes alone are too narrow or too small to trust: planes that the image's edges agree
     // with (an independent witness) make the frame, checked by the walls below as any other.
-    const EdgeCompassResult c = ask_compass();
+    const EdgeCompassResult& c = ask_compass();
     ManhattanEstimate confirmed = confirm(votes, total_area, c);
     if (!confirmed.found) {
       frame.why += c.valid && c.support >= cfg_.compass_min_support
@@ -472,6 +480,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
     for (const Vote* v : vetoes)
       walls_agree = walls_agree && std::fabs(wrap_quarter(v->a - veto->a)) <=
                                        std::max(disagree_tolerance(*v), disagree_tolerance(*veto));
+    bool edges_give_frame = false;
     if (!walls_agree && compass && cfg_.compass_veto_min_support < 1.f && cfg_.compass_veto_agreement > 0.f) {
       // Walls too narrow to make the frame say the furniture's frame is wrong, not which frame is
       // right; a sliver at the depth cut-off is good to a few degrees only (2.4 to 5 deg off with
@@ -491,32 +500,27 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
         float agree = 0.f;
         for (const Vote* v : vetoes)
           if (std::fabs(wrap_quarter(v->a - c.yaw)) <= cfg_.compass_veto_agreement) agree += v->area;
-        frame.yaw = manhattan_keep_branch(c.yaw, prev_yaw_);
-        frame.T_manhattan_floor = manhattan_pose_from_yaw(frame.yaw);
-        frame.vertical_area = agree;
-        frame.fraction = total_area > 0.f ? agree / total_area : 0.f;
-        prev_yaw_ = frame.yaw;
-        return frame;
+        set_frame(frame, manhattan_keep_branch(c.yaw, prev_yaw_), agree, total_area);
+        edges_give_frame = true;
       }
     }
-    if (!walls_agree) {
+    if (walls_agree) {
+      float sc = 0.f, ss = 0.f, agree = 0.f;
+      for (const Vote& v : votes) {
+        if (v.inside || v.tilted || std::fabs(wrap_quarter(v.a - veto->a)) > cfg_.cluster_tolerance) continue;
+        sc += v.w * std::cos(4.f * v.a);
+        ss += v.w * std::sin(4.f * v.a);
+        agree += v.area;
+      }
+      set_frame(frame, manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_), agree,
+                total_area);
+    } else if (!edges_give_frame) {
       est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
                 "the room in front of it)";
       est.fraction = frame.fraction;
       est.vertical_area = frame.vertical_area;
       return est;
     }
-    float sc = 0.f, ss = 0.f, agree = 0.f;
-    for (const Vote& v : votes) {
-      if (v.inside || v.tilted || std::fabs(wrap_quarter(v.a - veto->a)) > cfg_.cluster_tolerance) continue;
-      sc += v.w * std::cos(4.f * v.a);
-      ss += v.w * std::sin(4.f * v.a);
-      agree += v.area;
-    }
-    frame.yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);
-    frame.T_manhattan_floor = manhattan_pose_from_yaw(frame.yaw);
-    frame.vertical_area = agree;
-    frame.fraction = total_area > 0.f ? agree / total_area : 0.f;
   }
   prev_yaw_ = frame.yaw;
   return frame;
@@ -543,11 +547,8 @@ ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, floa
     wide = wide || (!hangs(v) && v.width >= cfg_.compass_min_width);
   }
   if (!wide) return est;
-  est.found = true;
-  est.yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);
-  est.T_manhattan_floor = manhattan_pose_from_yaw(est.yaw);
-  est.vertical_area = agree;
-  est.fraction = total_area > 0.f ? agree / total_area : 0.f;
+  set_frame(est, manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_), agree,
+            total_area);
   return est;
 }
 
