@@ -687,10 +687,13 @@ class TotalsCheck : public ::testing::Environment {
     // FarWallsFittedClearOfTheCutOff); 219/222 once the image edges agreeing with a wall at the
     // cut-off that vetoes the frame of clutter turned against the room gave the frame (room_clutter
     // #6 and #10, 2 deg off or more as the walls alone: ManhattanFrame.
-    // ImageEdgesGiveTheFrameThatFarWallsVetoed).
+    // ImageEdgesGiveTheFrameThatFarWallsVetoed); 220/222 once image edges too weak to confirm
+    // just any plane confirmed a strip of wall on the floor with nothing beyond it (people #14:
+    // ManhattanFrame.WeakImageEdgesConfirmAWallsFootInACorner).
     EXPECT_EQ(A.manhattan_wrong, 0) << "Manhattan yaw more than 2 deg off with a staircase in view";
     EXPECT_EQ(Totals::sequences().all.manhattan_wrong, 0) << "Manhattan yaw off, walking";
-    EXPECT_GE(A.manhattan_ok, 217) << "Manhattan frame within 2 deg where a wall or riser is in view (219/222)";
+    EXPECT_GE(A.manhattan_ok, 218)
+        << "Manhattan frame within 2 deg where a wall or riser is in view (220/222)";
     EXPECT_GE(Totals::sequences().all.manhattan_ok, 31) << "the same, walking (32/40)";
     EXPECT_LE(A.manhattan_off, 1) << "a frame more than 2 deg off with a wall in view (5 before the veto, 1 before "
                                      "the far walls were fitted clear of the cut-off, now 0)";
@@ -758,7 +761,7 @@ TEST_P(PerceptionPreset, FiguresOfIssue3) {
 // issue's figures: what they become when the synthetic sensor is as unkind as the real one,
 // held as regression floors. Measured on the default seed (white noise in brackets): floor
 // 427/428 (427/428), wrong plane 0 (0), treads 512/514 (514/514, two found 1-2 cm off in
-// height), mixed 0 (0), Manhattan 204/222 (219/222), no frame more than 2 deg off with a staircase
+// height), mixed 0 (0), Manhattan 204/222 (220/222), no frame more than 2 deg off with a staircase
 // in view (0), 9 with a wall in view (0). (203/222 before the image edges agreeing with a vetoing
 // wall at the depth cut-off gave the frame: ManhattanConfig::compass_veto_min_support. 200/222, 1
 // and 11 before a flat riser with a noisy patch at its edge was no longer taken for a facet of a

@@ -733,3 +733,63 @@ TEST(ManhattanFrame, ImageEdgesGiveTheFrameThatFarWallsVetoed) {
     EXPECT_LT(w.yaw_err, 0.f) << "#" << index << " without the rule: a frame " << w.yaw_err << " deg off";
   }
 }
+
+// A strip of wall 0.29 x 0.08 m standing on the floor 2.2 m ahead with nothing beyond it (a wall's
+// foot in a corner of the view) is too small to make a frame alone (min_area). Image edges too weak
+// to confirm just any plane (below compass_min_support, above compass_wall_min_support) confirm
+// it: the frame is the strip's yaw. They confirm no plane floating above the floor nor one with the
+// floor going on beyond it (furniture), and nothing when they disagree by more than
+// compass_agreement, have less support, or the rule is off.
+TEST(ManhattanFrame, WeakImageEdgesConfirmOnlyAWallStrip) {
+  const Pose T = level_camera();
+  const float deg = 3.14159265f / 180.f;
+  const float yaw = 7.f * deg;
+  const ManhattanConfig cfg;
+  ASSERT_LT(cfg.compass_wall_min_support, cfg.compass_min_support);
+  const float weak = 0.5f * (cfg.compass_wall_min_support + cfg.compass_min_support);
+  const PlaneRegion strip = upright_on_floor(T, 2.2f, yaw, 0.29f, 0.08f, 0.01f);
+  ASSERT_LT(strip.area, cfg.min_area);
+  const std::vector<PlaneRegion> wall = {floor_between(T, 0.8f, 2.2f), strip};
+  auto frame = [&](const std::vector<PlaneRegion>& planes, const std::function<EdgeCompassResult()>& compass,
+                   const ManhattanConfig& c = ManhattanConfig{}) {
+    ManhattanTracker m(c);
+    return m.estimate(planes, T, compass);
+  };
+  EXPECT_FALSE(frame(wall, {}).found) << "the strip alone made a frame";
+  const ManhattanEstimate e = frame(wall, compass_at(yaw + 0.5f * deg, weak));
+  ASSERT_TRUE(e.found) << e.why;
+  EXPECT_NEAR(e.yaw, yaw, 0.01f * deg) << "the frame is the strip's yaw";
+  EXPECT_FALSE(frame(wall, compass_at(yaw + cfg.compass_agreement + 0.5f * deg, weak)).found)
+      << "edges off the strip by more than compass_agreement";
+  const ManhattanEstimate none = frame(wall, compass_at(yaw, cfg.compass_wall_min_support - 0.01f));
+  EXPECT_FALSE(none.found) << "edges with too little support";
+  EXPECT_NE(none.why.find("no clear direction"), std::string::npos) << none.why;
+  ManhattanConfig off;
+  off.compass_wall_min_support = 1.f;
+  EXPECT_FALSE(frame(wall, compass_at(yaw, weak), off).found) << "rule off";
+  // Furniture: the same strip with the floor going on beyond it, or floating above the floor.
+  const std::vector<PlaneRegion> inside = {floor_between(T, 0.8f, 3.5f), strip};
+  const ManhattanEstimate f = frame(inside, compass_at(yaw, weak));
+  EXPECT_FALSE(f.found) << "a strip with the floor beyond it: frame " << f.yaw / deg << " deg";
+  EXPECT_NE(f.why.find("too weak"), std::string::npos) << f.why;
+  PlaneRegion floating = strip;
+  floating = lowered(floating, T, -0.5f);
+  EXPECT_FALSE(frame({floor_between(T, 0.8f, 2.2f), floating}, compass_at(yaw, weak)).found)
+      << "a strip floating above the floor";
+  // Edges with the support to confirm any plane confirm the furniture's strip (the rule it extends).
+  EXPECT_TRUE(frame(inside, compass_at(yaw, cfg.compass_min_support)).found);
+}
+
+// The same on the synthetic world (white noise, the suite's seed): people #14 sees the floor and,
+// in a corner, two patches of a wall's foot (0.017 and 0.005 m^2, 0.5 and 0.9 deg off); its image
+// edges are 0.9 deg off with support 0.08.
+TEST(ManhattanFrame, WeakImageEdgesConfirmAWallsFootInACorner) {
+  const View v = run_view("people_static", 14, kSuiteSeed);
+  ASSERT_GE(v.truth.wall_or_riser_pixels, 200);
+  EXPECT_GE(v.yaw_err, 0.f) << "no frame (" << v.sc.manhattan_why << ")";
+  EXPECT_LE(v.yaw_err, 2.f);
+  ManhattanConfig off;
+  off.compass_wall_min_support = 1.f;
+  const View w = run_view("people_static", 14, kSuiteSeed, off);
+  EXPECT_LT(w.yaw_err, 0.f) << "without the rule: a frame " << w.yaw_err << " deg off";
+}

@@ -266,6 +266,7 @@ struct ManhattanConfig {
   float compass_min_support = 0.2f;     ///< share of the image edges' votes at their peak direction (edge_compass.hpp) for it to count; 1: never asked
   float compass_agreement = 0.03490659f;  ///< rad, planes within this of that direction (modulo 90 deg) ... (2 deg)
   float compass_min_width = 0.2f;       ///< m, ... make the frame when one of them is this wide, even if too narrow or small to be trusted alone
+  float compass_wall_min_support = 0.06f;  ///< share at the peak for weaker edges to confirm wall strips only (on the floor, nothing beyond them); 1: never
   float compass_veto_min_support = 0.06f;  ///< share of the edges' votes at their peak for them to give a frame that narrow walls veto (1: never) ...
   float compass_veto_agreement = 0.10471976f;  ///< rad, ... when within this of the widest vetoing wall (6 deg; 0: never)
 
@@ -370,6 +371,9 @@ struct ManhattanConfig {
           "vertical planes within this of that direction (modulo 90 deg) ...");
     v.num(compass_min_width, "compass_min_width_cm", Unit::kCentimetre, 0, 1000,
           "... make the frame when one of them is this wide, although too narrow or too small to be trusted alone");
+    v.num(compass_wall_min_support, "compass_wall_min_support", Unit::kNone, 0, 1,
+          "edges with less support than compass_min_support, down to this, confirm only a wall strip (on the floor, "
+          "nothing seen beyond it, clear of the depth cut-off and near) too small to make the frame alone; 1: never");
     v.num(compass_veto_min_support, "compass_veto_min_support", Unit::kNone, 0, 1,
           "where walls too narrow to make a frame veto the furniture's (structure_beyond_area), the image edges' "
           "direction with this share of their votes at its peak gives the frame ...; 1: never");

@@ -156,6 +156,10 @@ class ManhattanTracker {
   float disagree_tolerance(const Vote& v) const;
   /// Width from which an agreeing plane makes the frame trusted on its own.
   float min_width(const Vote& v, bool bounding_only) const;
+  /// A strip of wall: on the floor, nothing seen beyond it (neither floor nor other surfaces),
+  /// narrower than min_plane_width, clear of the depth cut-off and near (not `far`), upright and
+  /// no band along a slope. Too narrow or too small to make a frame alone, it still is a wall.
+  bool wall_strip(const Vote& v) const;
   /// Inside the room and hanging above the floor (hanging_min_height): furniture or a person, never
   /// the plane that makes a frame alone, nor one of a pair with another such plane.
   bool hangs(const Vote& v) const;
