@@ -772,8 +772,7 @@ TEST(ManhattanFrame, WeakImageEdgesConfirmOnlyAWallStrip) {
   const ManhattanEstimate f = frame(inside, compass_at(yaw, weak));
   EXPECT_FALSE(f.found) << "a strip with the floor beyond it: frame " << f.yaw / deg << " deg";
   EXPECT_NE(f.why.find("too weak"), std::string::npos) << f.why;
-  PlaneRegion floating = strip;
-  floating = lowered(floating, T, -0.5f);
+  const PlaneRegion floating = lowered(strip, T, -0.5f);  // 0.5 m up
   EXPECT_FALSE(frame({floor_between(T, 0.8f, 2.2f), floating}, compass_at(yaw, weak)).found)
       << "a strip floating above the floor";
   // Edges with the support to confirm any plane confirm the furniture's strip (the rule it extends).
