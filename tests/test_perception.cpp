@@ -658,13 +658,12 @@ class TotalsCheck : public ::testing::Environment {
     EXPECT_EQ(A.treads_ok, A.treads) << "every tread found over all static presets (measured 514/514)";
     // Manhattan, issue 3's reading: a frame within 2 deg on every view with the floor and a wall
     // or riser (>= 200 px, >= 8 cm tall: an open riser's tread edge is none) in view. Measured
-    // 219/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
-    // in view, and none with only a wall in view. The misses, all views without a frame: walls and
-    // risers seen too small, narrow or far to trust, the image edges showing no clear direction to
-    // confirm them (3 views: a 0.017 m^2 patch of wall, a wall at the depth cut-off seen past a
-    // bench turned 23 deg, a lone wall at the cut-off), and a 450 px strip of wall while turning (8
-    // walking views: in the daemon the odometry carries the frame held in the world through them,
-    // see test_walk_manhattan).
+    // 220/222 static views, 32/40 walking; no frame is ever more than 2 deg off with a staircase
+    // in view, and none with only a wall in view. The misses, all views without a frame: walls seen
+    // only at the depth cut-off, too narrow to trust, the image edges not confirming them (2 views:
+    // a wall seen past a bench turned 23 deg, whose edges lead the compass, and a lone sliver of
+    // wall), and a 450 px strip of wall while turning (8 walking views: in the daemon the odometry
+    // carries the frame held in the world through them, see test_walk_manhattan).
     // History: counted only on views reporting a frame, 143/143. On every view: 209/241 once the
     // paper's 5 % share of planar area (it refused curbs' and single steps' risers 1.3 m wide) was
     // dropped and one narrow plane, or two faces of one box, no longer made a frame; 199/226 once

@@ -23,12 +23,13 @@
 /// cut-off disagrees only beyond clipped_disagreement. When the widest vetoing wall is
 /// min_plane_width wide, the walls agreeing with it give the frame instead; when it is narrower,
 /// the image edges' direction agreeing with it (compass_veto_*) and not with the vetoed frame gives
-/// the frame. A thin band along a
-/// sloping axis (a handrail beside a flight) votes but cannot make a frame: its yaw turns with its
-/// plane about that axis.
+/// the frame. A thin band along a sloping axis (a handrail beside a flight) votes but cannot make a
+/// frame: its yaw turns with its plane about that axis.
 /// When the planes alone make no trusted frame, the image edges' direction (edge_compass.hpp, an
 /// independent witness) is asked: planes agreeing with it within compass_agreement, one of them
-/// compass_min_width wide, make the frame (their own yaw), which the walls may still veto.
+/// compass_min_width wide, make the frame (their own yaw), which the walls may still veto. Edges
+/// too weak for that (below compass_min_support, down to compass_wall_min_support) confirm only
+/// strips of wall (wall_strip()), planes that are walls by their own evidence.
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
