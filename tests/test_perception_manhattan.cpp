@@ -491,6 +491,85 @@ TEST(ManhattanFrame, CompassConfirmsOnlyAgreeingPlanes) {
   }
 }
 
+// The views whose only wall in range is a strip at the depth cut-off, its fit too doubtful to trust
+// alone, and whose edges have no dominant direction (a floor of random texture fills the view):
+// on the suite's seed, a lone sliver of wall 0.55 m wide beside a bare floor (floor_only #17) and a
+// wall 0.47 m wide seen past a bench turned 23 deg (bench #14). The foot of the wall ahead, beyond
+// the cut-off, is a straight edge on the floor across the image, and the wall in range agrees with
+// it; on seeds 5 and 17, floor joints and a rug's edge do the same (ascending #7, room_clutter #0)
+// and give the frame within 0.1 deg where the walls' own fit was 2.0-2.1 deg off. Without the
+// lines (compass_line_min_length 0) none of these views has a frame.
+TEST(ManhattanFrame, FloorLinesConfirmWallsAtTheCutOff) {
+  ManhattanConfig no_lines;
+  no_lines.compass_line_min_length = 0.f;
+  for (const Case& c : {Case{"floor_only_static", 17, kSuiteSeed}, Case{"bench_static", 14, kSuiteSeed},
+                        Case{"ascending_static", 7, 5u}, Case{"room_clutter_static", 0, 17u}}) {
+    const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+    const View v = run_view(c.preset, c.index, c.seed);
+    ASSERT_GE(v.truth.wall_or_riser_pixels, 200) << name;
+    EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
+    std::printf("%s: %.2f deg off\n", name.c_str(), v.yaw_err);
+    EXPECT_LE(v.yaw_err, 1.f) << name;
+    const View w = run_view(c.preset, c.index, c.seed, no_lines);
+    EXPECT_LT(w.yaw_err, 0.f) << name << " without the lines: a frame " << w.yaw_err << " deg off";
+  }
+}
+
+/// Image edges without a dominant direction (a floor of random texture: `support` under
+/// compass_wall_min_support) but with one long straight edge on the floor at `line_yaw` (rad).
+std::function<EdgeCompassResult()> compass_with_floor_line(float line_yaw, float support = 0.02f) {
+  return [line_yaw, support]() {
+    EdgeCompassResult c;
+    c.valid = true;
+    c.yaw = line_yaw + 0.35f;  // the chance peak of the texture's edges, 20 deg away
+    c.support = support;
+    c.weight = 1.f;
+    EdgeLine l;
+    l.heading = line_yaw;
+    l.length = 500.f;
+    l.span = 560.f;
+    c.lines.push_back(l);
+    return c;
+  };
+}
+
+// A long straight edge on the floor (the foot of a wall, a floor joint) confirms a wall that
+// agrees with it within compass_agreement, compass_min_width wide, when the edges' dominant
+// direction confirms nothing; the frame is the line's direction. It confirms no plane with floor
+// beyond it (furniture, a person, a riser: inside the room, with its own edges along it), none
+// that disagrees by more than compass_agreement, and none narrower than compass_min_width.
+TEST(ManhattanFrame, FloorLineConfirmsAWall) {
+  const Pose T = level_camera();
+  const float yaw = 0.3f;  // 17 deg
+  const float deg = 3.14159265f / 180.f;
+  const ManhattanConfig cfg;
+  {
+    ManhattanTracker m(cfg);
+    const ManhattanEstimate e = m.estimate({vertical_patch(T, yaw, 0.3f)}, T, compass_with_floor_line(yaw + 0.5f * deg));
+    ASSERT_TRUE(e.found) << e.why;
+    EXPECT_NEAR(e.yaw, yaw + 0.5f * deg, 1e-4f) << "the frame is the line's direction";
+  }
+  {
+    ManhattanTracker m(cfg);
+    const ManhattanEstimate e =
+        m.estimate({vertical_patch(T, yaw, 0.3f)}, T, compass_with_floor_line(yaw + cfg.compass_agreement + 0.01f));
+    EXPECT_FALSE(e.found) << "a line disagreeing by more than compass_agreement confirmed the plane";
+  }
+  {
+    ManhattanTracker m(cfg);
+    const ManhattanEstimate e = m.estimate({vertical_patch(T, yaw, 0.16f)}, T, compass_with_floor_line(yaw));
+    EXPECT_FALSE(e.found) << "a plane narrower than compass_min_width was confirmed";
+  }
+  {
+    // A box's side 0.3 m wide standing on the floor 2 m ahead, the floor seen beyond it.
+    ManhattanTracker m(cfg);
+    const std::vector<PlaneRegion> planes{floor_between(T, 0.8f, 4.4f), upright_on_floor(T, 2.f, yaw, 0.3f, 0.4f, 0.02f)};
+    EXPECT_FALSE(m.estimate(planes, T).found) << "the box's side made a frame alone";
+    const ManhattanEstimate e = m.estimate(planes, T, compass_with_floor_line(yaw));
+    EXPECT_FALSE(e.found) << "a line confirmed a plane with floor beyond it";
+  }
+}
+
 // A band along a level axis (a riser's strip 7 cm tall) fixes its plane only up to a turn about
 // that axis: tilted 13 deg from vertical by its fit, its axis still gives the yaw. It joins the
 // planes the image edges confirm (heading from the axis), and makes no frame without them; tilted

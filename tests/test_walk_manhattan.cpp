@@ -132,7 +132,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         // Walking toward a staircase with a fast turn (up to 10 deg between frames), during which
         // the wall shows only as a strip too narrow to make a frame of its own. Measured 122/123
-        // (97/123 view by view): frame 33, facing the side wall at the start, sees a 515 px strip
+        // (95/123 view by view): frame 33, facing the side wall at the start, sees a 515 px strip
         // of it before any view has made a frame to hold.
         Walk{"ascending_turn_fast", 300, 1},
         Walk{"ascending_approach_climb", 600, 0},  // 374/374

@@ -532,7 +532,7 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
 ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, float total_area,
                                             const EdgeCompassResult& compass) const {
   ManhattanEstimate est;
-  if (!compass.valid) return est;
+  if (!compass.valid) return confirm_by_lines(votes, total_area, compass);
   // Edges with less support than compass_min_support, down to compass_wall_min_support, confirm
   // only wall strips (wall_strip()): planes whose own evidence already says wall, short only of
   // area (a strip of wall 0.29 x 0.11 m in a corner of the view, 0.5 deg off: people #14 on the
@@ -540,7 +540,7 @@ ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, floa
   // 0.04) and agree within compass_agreement; without them, such strips made frames 2.7 and
   // 4.7 deg off with the real-like noise (a single step and a curb seen in part).
   const bool weak = compass.support < cfg_.compass_min_support;
-  if (weak && compass.support < cfg_.compass_wall_min_support) return est;
+  if (weak && compass.support < cfg_.compass_wall_min_support) return confirm_by_lines(votes, total_area, compass);
   // The planes within compass_agreement of the edges' direction, one of them compass_min_width
   // wide (narrower ones, a person's limbs, agree with anything to degrees). Bands along a slope
   // and slivers at the depth cut-off, whose yaw may be off by degrees, neither make nor join it.
@@ -558,9 +558,44 @@ ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, floa
     agree += v.area;
     wide = wide || (!hangs(v) && v.width >= cfg_.compass_min_width);
   }
-  if (!wide) return est;
+  if (!wide) return confirm_by_lines(votes, total_area, compass);
   set_frame(est, manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_), agree,
             total_area);
+  return est;
+}
+
+// The image's long straight edges on the floor (EdgeCompassResult::lines) are a second witness,
+// asked when the edges' dominant direction confirms no plane: a long edge on the floor is the foot
+// of a wall (seen even beyond the depth cut-off, where the wall's own readings are gone), a joint of
+// the floor's boards or tiles, or the edge of a rug, and each runs along the room. On a floor of
+// random texture the edges' dominant direction is no more than a chance peak (the floor fills most
+// of the view), while the foot of a wall 6 m away is one straight edge across the image: on the
+// suite's seed, floor_only #17 sees a sliver of wall 0.55 m wide at the cut-off and that foot,
+// 518 px long and 0.03 deg off, and had no frame before.
+// A line confirms the planes within compass_agreement of it when one of them, compass_min_width
+// wide, stands for a wall: nothing is seen beyond it (not `inside`). Furniture, people and risers
+// have straight edges along themselves, which say nothing of the room, and a line never makes a
+// frame alone: the real kitchen's tile joints lie up to 4.4 deg from its walls' frame
+// (EdgeCompassRealData.KitchenFloorLinesAgreeWithTheWalls). The frame takes the line's direction:
+// a line hundreds of pixels long is sharper than the plane it confirms (white noise, seeds 5 and 17:
+// ascending #7 and room_clutter #0 were 2.07 and 2.01 deg off with the planes' own yaw, their lines
+// 0.12 and 0.02; on seeds 1-20, with the line's, 11 more views right and none off).
+ManhattanEstimate ManhattanTracker::confirm_by_lines(const std::vector<Vote>& votes, float total_area,
+                                                     const EdgeCompassResult& compass) const {
+  ManhattanEstimate est;
+  for (const EdgeLine& line : compass.lines) {  // longest first
+    float agree = 0.f;
+    bool wall = false;
+    for (const Vote& v : votes) {
+      if (v.sloped_band || v.sliver) continue;
+      if (std::fabs(wrap_quarter(v.a - line.heading)) > cfg_.compass_agreement) continue;
+      agree += v.area;
+      wall = wall || (v.has_side && !v.inside && v.width >= cfg_.compass_min_width);
+    }
+    if (!wall) continue;
+    set_frame(est, manhattan_keep_branch(wrap_quarter(line.heading), prev_yaw_), agree, total_area);
+    return est;
+  }
   return est;
 }
 

@@ -26,12 +26,17 @@ const char* to_string(RegionClass c) {
 Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor, const ManhattanConfig& manhattan,
                        const ClassificationConfig& classification)
     : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range, seg.depth_noise_coeff),
-      classification_(classification), manhattan_cfg_(manhattan) {}
+      classification_(classification), manhattan_cfg_(manhattan) {
+  EdgeCompassConfig compass;
+  compass.line_min_length = manhattan.compass_line_min_length;
+  compass_ = EdgeCompass(compass);
+}
 
 Perception::Perception(const PipelineConfig& c)
     : Perception(c.segmentation, c.floor, c.manhattan, c.classification) {
   // Vertical planes seen at the depth cut-off give the Manhattan frame no direction.
   manhattan_ = ManhattanTracker(c.manhattan, c.capture.max_range, c.segmentation.depth_noise_coeff);
+  max_range_ = c.capture.max_range;
 }
 
 void Perception::reset() {
@@ -93,9 +98,10 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
       EdgeCompass& compass;
       const RgbdFrame& frame;
       const Pose& T;
-    } ask{compass_, frame, T_upright_camera};
+      float max_range;
+    } ask{compass_, frame, T_upright_camera, max_range_};
     const ManhattanEstimate m = manhattan_.estimate(out.regions, T_upright_camera, [&ask]() {
-      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T.linear());
+      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T, ask.frame.depth, ask.max_range);
     });
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;

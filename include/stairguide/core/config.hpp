@@ -269,6 +269,7 @@ struct ManhattanConfig {
   float compass_wall_min_support = 0.06f;  ///< share at the peak for weaker edges to confirm wall strips only (on the floor, nothing beyond them); 1: never
   float compass_veto_min_support = 0.06f;  ///< share of the edges' votes at their peak for them to give a frame that narrow walls veto (1: never) ...
   float compass_veto_agreement = 0.10471976f;  ///< rad, ... when within this of the widest vetoing wall (6 deg; 0: never)
+  float compass_line_min_length = 150.f;  ///< px, a straight edge on the floor this long (edge_compass.hpp) confirms a wall within compass_agreement of it when the edges' dominant direction confirms none; 0: never
 
   template <class V> void visit(V& v) {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
@@ -380,6 +381,10 @@ struct ManhattanConfig {
     v.num(compass_veto_agreement, "compass_veto_agreement_deg", Unit::kDegree, 0, 45,
           "... when it agrees within this with the widest vetoing wall (modulo 90 deg) and not with the furniture's "
           "frame; 0: never");
+    v.num(compass_line_min_length, "compass_line_min_length_px", Unit::kPixel, 0, 10000,
+          "where the edges' dominant direction confirms no plane, a straight edge lying on the floor (a wall's foot, "
+          "even beyond the depth cut-off; a floor joint) this long gives the frame its direction when a wall, "
+          "compass_min_width wide, agrees with it within compass_agreement; 0: never");
     v.flag(without_floor, "without_floor",
            "with no floor found, measure the frame about the vertical of a floor-like plane the floor's checks refused "
            "(a tread, a seat: which level the user stands on is in doubt, which way is up is not)");

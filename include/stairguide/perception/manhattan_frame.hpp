@@ -29,7 +29,10 @@
 /// independent witness) is asked: planes agreeing with it within compass_agreement, one of them
 /// compass_min_width wide, make the frame (their own yaw), which the walls may still veto. Edges
 /// too weak for that (below compass_min_support, down to compass_wall_min_support) confirm only
-/// strips of wall (wall_strip()), planes that are walls by their own evidence.
+/// strips of wall (wall_strip()), planes that are walls by their own evidence. When the edges'
+/// direction confirms nothing, a long straight edge lying on the floor (the foot of a wall, a
+/// floor joint: EdgeCompassResult::lines) confirms a wall that agrees with it within
+/// compass_agreement, and the frame takes the line's direction (confirm_by_lines()).
 /// k_M is the one nearest the user's forward direction z_F; across frames the branch nearest the
 /// previous k_M is kept when the choice is ambiguous (near +-45 degrees).
 
@@ -171,6 +174,9 @@ class ManhattanTracker {
   void mark_risers(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
   /// The frame of the planes agreeing with the image edges' direction (see estimate()).
   ManhattanEstimate confirm(const std::vector<Vote>& votes, float total_area, const EdgeCompassResult& compass) const;
+  /// The frame of a long straight edge on the floor that a wall agrees with (see estimate()).
+  ManhattanEstimate confirm_by_lines(const std::vector<Vote>& votes, float total_area,
+                                     const EdgeCompassResult& compass) const;
 
   ManhattanConfig cfg_;
   float max_range_ = 0.f;

@@ -95,6 +95,7 @@ class Perception {
   FloorDetector floor_;
   ManhattanTracker manhattan_;
   EdgeCompass compass_;
+  float max_range_ = CaptureConfig{}.max_range;  // m, the depth cut-off (the compass's floor lines)
   ClassificationConfig classification_;
   FloorEstimate floor_est_;
   ManhattanConfig manhattan_cfg_;
