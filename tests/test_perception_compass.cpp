@@ -5,20 +5,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
-#include <opencv2/imgproc.hpp>
-
+#include "manhattan_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/edge_compass.hpp"
 #include "stairguide/perception/manhattan_frame.hpp"
 #include "stairguide/perception/perception.hpp"
-#include "manhattan_test_util.hpp"
 
 using namespace stairguide;
 
@@ -213,6 +213,23 @@ float yaw_error_deg(SceneResult sc, const FrameTruth& truth, float yaw) {
   sc.manhattan_yaw = yaw;
   return sg_test::manhattan_yaw_error_deg(sc, truth);
 }
+
+/// A synthetic view through perception, and the compass's floor lines on it (the floor must be found).
+struct FloorLinesView {
+  RgbdFrame frame;
+  FrameTruth truth;
+  SceneResult sc;
+  EdgeCompass compass;
+  EdgeCompassResult r;
+  FloorLinesView(const char* preset, int index, std::uint32_t seed) {
+    synth::render_preset_frame(preset, index, seed, synth::SynthOptions{}, frame, truth);
+    Perception P;
+    P.process(frame, sc);
+    if (sc.floor_found)
+      r = compass.estimate(frame.gray, frame.intrinsics, sc.T_floor_camera, frame.depth,
+                           CaptureConfig{}.max_range);
+  }
+};
 }  // namespace
 
 // The straight edges that lie on the floor (EdgeCompassResult::lines): in a view of a bare floor
@@ -220,26 +237,20 @@ float yaw_error_deg(SceneResult sc, const FrameTruth& truth, float yaw) {
 // the foot of the wall ahead, beyond the cut-off and without a reading, runs across the image:
 // one line, with the room's direction.
 TEST(EdgeCompass, FloorLineIsTheFootOfAWallBeyondTheCutOff) {
-  RgbdFrame frame;
-  FrameTruth truth;
-  synth::render_preset_frame("floor_only_static", 17, 20261123u, synth::SynthOptions{}, frame, truth);
-  Perception P;
-  SceneResult sc;
-  P.process(frame, sc);
+  FloorLinesView v("floor_only_static", 17, 20261123u);
+  const SceneResult& sc = v.sc;
+  const EdgeCompassResult& r = v.r;
   ASSERT_TRUE(sc.floor_found);
-  EdgeCompass compass;
-  const EdgeCompassResult r =
-      compass.estimate(frame.gray, frame.intrinsics, sc.T_floor_camera, frame.depth, CaptureConfig{}.max_range);
   ASSERT_FALSE(r.lines.empty());
   for (const EdgeLine& l : r.lines)
-    std::printf("floor_only #17: line %.0f px (span %.0f) from (%.0f, %.0f) to (%.0f, %.0f), %.2f deg off\n", l.length,
-                l.span, l.a.x(), l.a.y(), l.b.x(), l.b.y(), yaw_error_deg(sc, truth, l.heading));
+    std::printf("floor_only #17: line %.0f px (span %.0f) from (%.0f, %.0f) to (%.0f, %.0f), %.2f deg off\n",
+                l.length, l.span, l.a.x(), l.a.y(), l.b.x(), l.b.y(), yaw_error_deg(sc, v.truth, l.heading));
   // Measured: the foot of the wall, 518 px along a span of 561, 0.03 deg off; a second line, 191 px
   // (a joint of the floor), 0.06 deg off.
   EXPECT_GE(r.lines[0].span, 400.f);
-  EXPECT_LT(yaw_error_deg(sc, truth, r.lines[0].heading), 0.3f);
+  EXPECT_LT(yaw_error_deg(sc, v.truth, r.lines[0].heading), 0.3f);
   // Without the depth, no line can be told to lie on the floor: none is given.
-  EXPECT_TRUE(compass.estimate(frame.gray, frame.intrinsics, sc.T_floor_camera.linear()).lines.empty());
+  EXPECT_TRUE(v.compass.estimate(v.frame.gray, v.frame.intrinsics, sc.T_floor_camera.linear()).lines.empty());
 }
 
 // A bench seen from above (seed 7, bench #23): the edges of its top board and legs are straight
@@ -247,20 +258,12 @@ TEST(EdgeCompass, FloorLineIsTheFootOfAWallBeyondTheCutOff) {
 // floor (the floor's depth is not seen on both sides of them), so none is given. Before the test of
 // the depth beside them, an edge of its end 191 px long confirmed a wall strip 4.3 deg off.
 TEST(EdgeCompass, FurnitureEdgesAreNoFloorLines) {
-  RgbdFrame frame;
-  FrameTruth truth;
-  synth::render_preset_frame("bench_static", 23, 7u, synth::SynthOptions{}, frame, truth);
-  Perception P;
-  SceneResult sc;
-  P.process(frame, sc);
-  ASSERT_TRUE(sc.floor_found);
-  EdgeCompass compass;
-  const EdgeCompassResult r =
-      compass.estimate(frame.gray, frame.intrinsics, sc.T_floor_camera, frame.depth, CaptureConfig{}.max_range);
-  for (const EdgeLine& l : r.lines) {
-    const float err = yaw_error_deg(sc, truth, l.heading);
-    std::printf("bench #23: line %.0f px from (%.0f, %.0f) to (%.0f, %.0f), %.2f deg off\n", l.length, l.a.x(),
-                l.a.y(), l.b.x(), l.b.y(), err);
+  const FloorLinesView v("bench_static", 23, 7u);
+  ASSERT_TRUE(v.sc.floor_found);
+  for (const EdgeLine& l : v.r.lines) {
+    const float err = yaw_error_deg(v.sc, v.truth, l.heading);
+    std::printf("bench #23: line %.0f px from (%.0f, %.0f) to (%.0f, %.0f), %.2f deg off\n", l.length,
+                l.a.x(), l.a.y(), l.b.x(), l.b.y(), err);
     EXPECT_LT(err, 1.f) << "a line off the room's axes";
   }
 }
@@ -291,7 +294,8 @@ TEST(EdgeCompassRealData, KitchenFloorLinesAgreeWithTheWalls) {
     P.process(f, sc);
     if (!sc.floor_found || !sc.manhattan_found) continue;
     ++views;
-    const EdgeCompassResult r = compass.estimate(f.gray, f.intrinsics, sc.T_floor_camera, f.depth, CaptureConfig{}.max_range);
+    const EdgeCompassResult r =
+        compass.estimate(f.gray, f.intrinsics, sc.T_floor_camera, f.depth, CaptureConfig{}.max_range);
     for (const EdgeLine& l : r.lines) {
       const float diff = std::fabs(sg_test::wrap45(l.heading - sc.manhattan_yaw)) / kDeg;
       ++lines;
@@ -299,8 +303,9 @@ TEST(EdgeCompassRealData, KitchenFloorLinesAgreeWithTheWalls) {
       worst = std::max(worst, diff);
     }
   }
-  std::printf("kitchen: %d floor lines on %d views, %d within 2 deg of the planes' frame, the worst %.2f deg\n", lines,
-              views, within2, worst);
+  std::printf(
+      "kitchen: %d floor lines on %d views, %d within 2 deg of the planes' frame, the worst %.2f deg\n",
+      lines, views, within2, worst);
   EXPECT_GE(views, 25);
   EXPECT_GE(lines, 200) << "the tiles' joints are no longer found";
   EXPECT_GE(within2, 0.8 * lines);

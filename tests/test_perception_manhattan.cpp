@@ -504,7 +504,8 @@ TEST(ManhattanFrame, FloorLinesConfirmWallsAtTheCutOff) {
   no_lines.compass_line_min_length = 0.f;
   for (const Case& c : {Case{"floor_only_static", 17, kSuiteSeed}, Case{"bench_static", 14, kSuiteSeed},
                         Case{"ascending_static", 7, 5u}, Case{"room_clutter_static", 0, 17u}}) {
-    const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+    const std::string name =
+        std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
     const View v = run_view(c.preset, c.index, c.seed);
     ASSERT_GE(v.truth.wall_or_riser_pixels, 200) << name;
     EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
@@ -545,14 +546,15 @@ TEST(ManhattanFrame, FloorLineConfirmsAWall) {
   const ManhattanConfig cfg;
   {
     ManhattanTracker m(cfg);
-    const ManhattanEstimate e = m.estimate({vertical_patch(T, yaw, 0.3f)}, T, compass_with_floor_line(yaw + 0.5f * deg));
+    const ManhattanEstimate e =
+        m.estimate({vertical_patch(T, yaw, 0.3f)}, T, compass_with_floor_line(yaw + 0.5f * deg));
     ASSERT_TRUE(e.found) << e.why;
     EXPECT_NEAR(e.yaw, yaw + 0.5f * deg, 1e-4f) << "the frame is the line's direction";
   }
   {
     ManhattanTracker m(cfg);
-    const ManhattanEstimate e =
-        m.estimate({vertical_patch(T, yaw, 0.3f)}, T, compass_with_floor_line(yaw + cfg.compass_agreement + 0.01f));
+    const ManhattanEstimate e = m.estimate({vertical_patch(T, yaw, 0.3f)}, T,
+                                           compass_with_floor_line(yaw + cfg.compass_agreement + 0.01f));
     EXPECT_FALSE(e.found) << "a line disagreeing by more than compass_agreement confirmed the plane";
   }
   {
@@ -563,7 +565,8 @@ TEST(ManhattanFrame, FloorLineConfirmsAWall) {
   {
     // A box's side 0.3 m wide standing on the floor 2 m ahead, the floor seen beyond it.
     ManhattanTracker m(cfg);
-    const std::vector<PlaneRegion> planes{floor_between(T, 0.8f, 4.4f), upright_on_floor(T, 2.f, yaw, 0.3f, 0.4f, 0.02f)};
+    const std::vector<PlaneRegion> planes{floor_between(T, 0.8f, 4.4f),
+                                          upright_on_floor(T, 2.f, yaw, 0.3f, 0.4f, 0.02f)};
     EXPECT_FALSE(m.estimate(planes, T).found) << "the box's side made a frame alone";
     const ManhattanEstimate e = m.estimate(planes, T, compass_with_floor_line(yaw));
     EXPECT_FALSE(e.found) << "a line confirmed a plane with floor beyond it";

@@ -151,8 +151,8 @@ EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrins
   return out;
 }
 
-EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrinsics& K, const Pose& T_floor_camera,
-                                        const cv::Mat& depth, float max_range) {
+EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrinsics& K,
+                                        const Pose& T_floor_camera, const cv::Mat& depth, float max_range) {
   EdgeCompassResult out = estimate(gray, K, T_floor_camera.linear());
   if (cfg_.line_min_length > 0.f && !half_.empty() && depth.type() == CV_32FC1 && depth.size() == gray.size())
     find_lines(K, T_floor_camera, depth, max_range, out);
@@ -180,7 +180,7 @@ bool EdgeCompass::on_floor(const Eigen::Vector2f& p1, const Eigen::Vector2f& p2,
     const float down = -(R * ray).y();
     ++samples;
     if (!(down > 1e-6f)) continue;  // above the horizon: not on the floor
-    const float zf = h / down;       // depth of the floor point on this ray
+    const float zf = h / down;      // depth of the floor point on this ray
     const float tol = 0.05f + 0.03f * zf;
     int sides = 0, pass = 0;
     for (float sgn : {-1.f, 1.f}) {
@@ -200,7 +200,8 @@ void EdgeCompass::find_lines(const CameraIntrinsics& K, const Pose& T_floor_came
                              float max_range, EdgeCompassResult& out) {
   const CameraIntrinsics Kh = K.scaled(0.5f);
   const Eigen::Matrix3f Rf = T_floor_camera.linear();
-  const Eigen::Vector3f fx_c = Rf.row(0).transpose(), up_c = Rf.row(1).transpose(), fz_c = Rf.row(2).transpose();
+  const Eigen::Vector3f fx_c = Rf.row(0).transpose(), up_c = Rf.row(1).transpose(),
+                        fz_c = Rf.row(2).transpose();
   // OpenCV's line segment detector (LSD, von Gioi et al.) on the half-resolution image: 9-10 ms on a
   // synthetic view, 4x less than at full resolution, and its segments less broken by the texture's
   // grain. It breaks a long edge into pieces wherever the grain or the noise crosses it; the pieces
@@ -250,7 +251,8 @@ void EdgeCompass::find_lines(const CameraIntrinsics& K, const Pose& T_floor_came
       mean /= wsum;
       Eigen::Matrix2f C = Eigen::Matrix2f::Zero();
       for (std::size_t j : members)
-        for (const Eigen::Vector2f& p : {segs[j].a, segs[j].b}) C += segs[j].len * (p - mean) * (p - mean).transpose();
+        for (const Eigen::Vector2f& p : {segs[j].a, segs[j].b})
+          C += segs[j].len * (p - mean) * (p - mean).transpose();
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> es(C);
       Eigen::Vector2f nd = es.eigenvectors().col(1);
       if (nd.dot(d) < 0.f) nd = -nd;
@@ -261,7 +263,8 @@ void EdgeCompass::find_lines(const CameraIntrinsics& K, const Pose& T_floor_came
     for (std::size_t j : members) {
       used[j] = 1;
       length += segs[j].len;
-      for (const Eigen::Vector2f& p : {segs[j].a, segs[j].b}) lo = std::min(lo, d.dot(p - c)), hi = std::max(hi, d.dot(p - c));
+      for (const Eigen::Vector2f& p : {segs[j].a, segs[j].b})
+        lo = std::min(lo, d.dot(p - c)), hi = std::max(hi, d.dot(p - c));
     }
     if (2.f * length < cfg_.line_min_length) continue;
     const Eigen::Vector2f p1 = c + lo * d, p2 = c + hi * d;
@@ -272,9 +275,11 @@ void EdgeCompass::find_lines(const CameraIntrinsics& K, const Pose& T_floor_came
     const float n2 = mx * mx + my * my + mz * mz;
     if (!(n2 > 0.f) || my * my < min_h2 * n2) continue;
     if (!on_floor(2.f * p1, 2.f * p2, K, T_floor_camera, depth, max_range)) continue;
-    out.lines.push_back({manhattan_wrap(std::atan2(-mz, mx)), 2.f * length, 2.f * (hi - lo), 2.f * p1, 2.f * p2});
+    out.lines.push_back(
+        {manhattan_wrap(std::atan2(-mz, mx)), 2.f * length, 2.f * (hi - lo), 2.f * p1, 2.f * p2});
   }
-  std::sort(out.lines.begin(), out.lines.end(), [](const EdgeLine& x, const EdgeLine& y) { return x.length > y.length; });
+  std::sort(out.lines.begin(), out.lines.end(),
+            [](const EdgeLine& x, const EdgeLine& y) { return x.length > y.length; });
 }
 
 }  // namespace stairguide

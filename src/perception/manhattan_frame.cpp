@@ -540,7 +540,8 @@ ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, floa
   // 0.04) and agree within compass_agreement; without them, such strips made frames 2.7 and
   // 4.7 deg off with the real-like noise (a single step and a curb seen in part).
   const bool weak = compass.support < cfg_.compass_min_support;
-  if (weak && compass.support < cfg_.compass_wall_min_support) return confirm_by_lines(votes, total_area, compass);
+  if (weak && compass.support < cfg_.compass_wall_min_support)
+    return confirm_by_lines(votes, total_area, compass);
   // The planes within compass_agreement of the edges' direction, one of them compass_min_width
   // wide (narrower ones, a person's limbs, agree with anything to degrees). Bands along a slope
   // and slivers at the depth cut-off, whose yaw may be off by degrees, neither make nor join it.

@@ -23,10 +23,13 @@ const char* to_string(RegionClass c) {
   return "unclassified";
 }
 
-Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor, const ManhattanConfig& manhattan,
-                       const ClassificationConfig& classification)
-    : segmentation_(seg), floor_(floor), manhattan_(manhattan, CaptureConfig{}.max_range, seg.depth_noise_coeff),
-      classification_(classification), manhattan_cfg_(manhattan) {
+Perception::Perception(const SegmentationConfig& seg, const FloorConfig& floor,
+                       const ManhattanConfig& manhattan, const ClassificationConfig& classification)
+    : segmentation_(seg),
+      floor_(floor),
+      manhattan_(manhattan, CaptureConfig{}.max_range, seg.depth_noise_coeff),
+      classification_(classification),
+      manhattan_cfg_(manhattan) {
   EdgeCompassConfig compass;
   compass.line_min_length = manhattan.compass_line_min_length;
   compass_ = EdgeCompass(compass);
@@ -101,7 +104,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
       float max_range;
     } ask{compass_, frame, T_upright_camera, max_range_};
     const ManhattanEstimate m = manhattan_.estimate(out.regions, T_upright_camera, [&ask]() {
-      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T, ask.frame.depth, ask.max_range);
+      return ask.compass.estimate(ask.frame.gray, ask.frame.intrinsics, ask.T, ask.frame.depth,
+                                  ask.max_range);
     });
     out.manhattan_found = m.found;
     out.manhattan_fraction = m.fraction;
