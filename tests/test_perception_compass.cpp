@@ -9,16 +9,17 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
-#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
-#include "manhattan_test_util.hpp"
+#include <opencv2/imgproc.hpp>
+
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/edge_compass.hpp"
 #include "stairguide/perception/manhattan_frame.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "manhattan_test_util.hpp"
 
 using namespace stairguide;
 
