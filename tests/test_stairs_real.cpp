@@ -1,6 +1,7 @@
 // Stair detection on the real frames of ../shared/data (labels.csv): what their labels allow.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -47,7 +48,8 @@ TEST(StairsReal, LabelledFrames) {
   StairStage stage(cfg);
   int none_frames = 0, none_detected = 0, stair_frames = 0, stair_detected = 0, wrong_direction = 0;
   int fhg_detected = 0, capture_stacked_up = 0;
-  for (const auto& row : read_labels(labels)) {
+  const auto rows = read_labels(labels);
+  for (const auto& row : rows) {
     std::unique_ptr<FrameSource> src;
     try {
       src = open_frame_source(dir + "/" + row[0], cfg.capture);
@@ -109,7 +111,11 @@ TEST(StairsReal, LabelledFrames) {
   }
   std::printf("real frames: 'none' %d of %d detected; 'stair' %d of %d detected\n", none_detected, none_frames,
               stair_detected, stair_frames);
-  EXPECT_EQ(none_frames, 7);
+  // Every stair-free frame labels.csv lists (12 since the boxes and the floor with a chair came),
+  // each read and each silent: the count follows the file, and may only grow.
+  EXPECT_GE(none_frames, 12);
+  EXPECT_EQ(none_frames, static_cast<int>(std::count_if(rows.begin(), rows.end(),
+                                                        [](const auto& r) { return r[1] == "none"; })));
   EXPECT_EQ(none_detected, 0) << "a staircase reported in a frame without one";
   EXPECT_EQ(wrong_direction, 0);
   // The two close-ups of two nosings (no floor at all): both detected ascending, riser and tread

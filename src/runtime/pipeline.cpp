@@ -4,6 +4,7 @@
 #include "stairguide/runtime/pipeline.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <utility>
@@ -18,6 +19,35 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The detection as the user is told it. The distance and bearing are measured in the plane
+// perpendicular to the stair's own vertical (y_S), from the point under the camera, the bearing
+// from the camera's forward direction in that plane: the same with a floor in view and with a
+// remembered one; unknown without either.
+StairSummary summarize(const StairResult& r) {
+  StairSummary s;
+  s.detected = r.detected;
+  if (!r.detected) return s;
+  s.kind = r.kind;
+  s.direction = r.direction();
+  s.without_floor = r.without_floor;
+  s.levels = r.levels;
+  s.riser_m = r.riser_m;
+  s.tread_m = r.tread_m;
+  s.width_m = r.width_m;
+  s.T_camera_stair = r.T_camera_stair;
+  if (r.without_floor) return s;
+  const Eigen::Vector3f up = r.T_camera_stair.rotation().col(1);
+  const Eigen::Vector3f o = r.origin();
+  const Eigen::Vector3f oh = o - o.dot(up) * up;
+  Eigen::Vector3f fwd = Eigen::Vector3f::UnitZ() - up.z() * up;
+  if (fwd.norm() < 1e-3f) return s;  // looking straight down: no forward direction
+  fwd.normalize();
+  const Eigen::Vector3f right = fwd.cross(up);
+  s.distance_m = oh.norm();
+  s.bearing_rad = std::atan2(oh.dot(right), oh.dot(fwd));
+  return s;
 }
 
 }  // namespace
@@ -108,6 +138,7 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   // of treads by their own vertical, with the distance from the user's feet unknown.
   m.stairs.run(m.scene, &frame.intrinsics, m.stair);
   out.stair_detected = m.stair.detected;
+  out.stair = summarize(m.stair);
   if (m.stair.detected) {
     out.state = to_string(m.stair.kind);
     out.levels = m.stair.levels;

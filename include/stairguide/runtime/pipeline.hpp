@@ -20,6 +20,7 @@
 
 #include "stairguide/core/config.hpp"
 #include "stairguide/core/types.hpp"
+#include "stairguide/stairs/traversal_result.hpp"
 
 namespace stairguide {
 struct OdometryLink;  // perception/perception.hpp
@@ -52,6 +53,9 @@ struct PerceptionOutput {
   bool manhattan_found = false;
   bool manhattan_carried = false;
   float manhattan_yaw = 0.f;  ///< rad, k_M from the floor frame's forward axis
+  /// The typed results: what the feedback room reads (as numbers, not from `detail`).
+  StairSummary stair;
+  TraversalResult traversal;  ///< `ran` false while the library has no traversal stage
   double ms = 0.0;     ///< time spent in the stages
 };
 
