@@ -276,7 +276,9 @@ TEST(Runtime, RealTimeReplayIsPacedByTimestamps) {
   const double s = std::chrono::duration<double>(Clock::now() - t0).count();
   rt.join(std::chrono::seconds(1));
   EXPECT_GE(s, 0.48);
-  EXPECT_LT(s, 2.0);
+  // Not stuck and not free-running either way: under ThreadSanitizer on a 2-core machine loaded by
+  // parallel builds the 16 frames took 3.4 s (perception there is many times slower than 30 Hz).
+  EXPECT_LT(s, 8.0);
   // Pacing is what this checks. Perception skipping to the newest frame is by design when it
   // falls behind; under ThreadSanitizer (tools/tsan-runtime) on a loaded 2-core machine it did
   // once skip 1 of the 16 frames. Most frames must still be perceived.
@@ -404,7 +406,9 @@ TEST(Runtime, ManhattanFrameIsCarriedByTheOdometryThroughAFastTurn) {
     if (sync) {
       EXPECT_EQ(rt.run(), 0);
     } else {
-      ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(120)));
+      // 110 frames of the full pipeline took past 120 s under ThreadSanitizer with parallel
+      // builds loading the 2 cores: the bound says "finishes", not how fast.
+      ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(400)));
       ASSERT_TRUE(rt.join(std::chrono::seconds(1)));
       EXPECT_EQ(rt.exit_code(), 0);
     }
