@@ -13,7 +13,8 @@ snd_pcm_t* as_pcm(void* p) { return static_cast<snd_pcm_t*>(p); }
 // libasound prints its own errors to stderr; the sink reports through its events instead.
 void quiet_alsa(const char*, int, const char*, int, const char*, ...) {}
 constexpr snd_pcm_uframes_t kChunk = 512;  // frames per write (23 ms at 22050 Hz)
-constexpr auto kStopGrace = std::chrono::seconds(2);
+// At stop, what is playing or queued may go on this long (drain() first to hear everything).
+constexpr auto kStopGrace = std::chrono::milliseconds(300);
 }  // namespace
 
 AlsaAudioSink::AlsaAudioSink(AlsaSinkOptions options, SoundBank bank, AudioEvents events)
@@ -26,6 +27,7 @@ AlsaAudioSink::~AlsaAudioSink() {
   {
     std::lock_guard<std::mutex> lk(m_);
     stop_ = true;
+    stop_deadline_ = SteadyClock::now() + kStopGrace;
   }
   cv_.notify_all();
   if (thread_.joinable()) thread_.join();
@@ -105,7 +107,6 @@ bool AlsaAudioSink::play_one(const Utterance& u) {
   snd_pcm_t* pcm = as_pcm(pcm_);
   std::size_t off = 0;
   bool started = false;
-  const auto deadline = SteadyClock::now() + kStopGrace;
   // Never more than the device's buffer ahead of real time: a real card holds us back by itself,
   // a PCM that takes samples at once (null, file) is held back here, so that a cut comes when
   // it would on a card.
@@ -121,7 +122,7 @@ bool AlsaAudioSink::play_one(const Utterance& u) {
                      [&] { return cut_ || stop_; });
         continue;
       }
-      if (cut_ || (stop_ && SteadyClock::now() > deadline)) {
+      if (cut_ || (stop_ && SteadyClock::now() > stop_deadline_)) {
         snd_pcm_drop(pcm);
         snd_pcm_prepare(pcm);
         ++counters_.cut;
@@ -179,6 +180,7 @@ void AlsaAudioSink::run() {
         queue_.pop_front();
         ++counters_.stale;
       }
+      if (stop_ && now > stop_deadline_) queue_.clear();
       if (queue_.empty() || (stop_ && pcm_ == nullptr)) {
         cv_.notify_all();
         if (stop_) break;

@@ -90,7 +90,7 @@ struct AlsaSinkOptions {
 class AlsaAudioSink : public AudioSink {
  public:
   AlsaAudioSink(AlsaSinkOptions options, SoundBank bank, AudioEvents events);
-  ~AlsaAudioSink() override;  ///< plays out what is queued (at most ~2 s), then closes
+  ~AlsaAudioSink() override;  ///< plays on at most 0.3 s (call drain() to hear all), then closes
   void play(Utterance u) override;
   bool drain(std::chrono::milliseconds timeout) override;
   std::string describe() const override;
@@ -117,6 +117,7 @@ class AlsaAudioSink : public AudioSink {
   int playing_priority_ = -1;  // -1: idle
   bool cut_ = false;
   bool stop_ = false;
+  SteadyClock::time_point stop_deadline_{};
   bool failing_ = false;  // the device failed; warned once until it opens again
   Counters counters_;
   std::thread thread_;
