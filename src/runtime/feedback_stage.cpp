@@ -195,4 +195,11 @@ FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
   return c;
 }
 
+void FeedbackStage::clear_cue_latency() {
+  std::lock_guard<std::mutex> lk(impl_->lat_mutex);
+  impl_->latency.clear();
+  impl_->pending.clear();
+  impl_->cues = 0;
+}
+
 }  // namespace stairguide::runtime

@@ -152,6 +152,7 @@ class FeedbackStage {
     std::string last;  ///< token of the last cue given ("" none)
   };
   CueLatency cue_latency() const;  ///< any thread
+  void clear_cue_latency();         ///< forgets the latencies measured so far (benchmarks)
 
  private:
   struct Impl;

@@ -125,9 +125,16 @@ runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int fr
   c.feedback.count_interval = 100;  // ticks only (no spoken counts)
   c.feedback.min_tick_interval = 0.f;
   runtime::FeedbackStage stage(c);
+  // "ready" and "first step" come on the first frame (the second waits for the first to end):
+  // the steps that follow are measured on an idle sink.
+  const int warmup = 30;
   const auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < frames; ++i) {
-    std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i);
+  for (int i = 0; i < warmup + frames; ++i) {
+    if (i == warmup) {
+      stage.drain(std::chrono::milliseconds(3000));
+      stage.clear_cue_latency();
+    }
+    std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i + std::chrono::seconds(i >= warmup ? 1 : 0));
     runtime::PerceptionOutput p;
     p.seq = static_cast<std::uint64_t>(i);
     p.ran = true;
@@ -137,7 +144,7 @@ runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int fr
     p.traversal.state = TraversalState::kOnStairs;
     p.traversal.kind = StairKind::kAscending;
     p.traversal.direction = 1;
-    p.traversal.steps_climbed = p.traversal.step_index = 1 + i / 3;
+    p.traversal.steps_climbed = p.traversal.step_index = i < warmup ? 1 : 1 + (i - warmup) / 3;
     stage.decide(p, nullptr, i / 30.0, std::chrono::steady_clock::now());
   }
   stage.drain(std::chrono::milliseconds(3000));
