@@ -4,13 +4,12 @@
 // cross-correlation with the WAVs.
 #include <stdlib.h>
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -23,12 +22,13 @@ namespace fs = std::filesystem;
 inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
 
 /// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 mono raw).
-inline void write_alsa_config(const fs::path& conf, const fs::path& dir, const std::vector<std::string>& names) {
+inline void write_alsa_config(const fs::path& conf, const fs::path& dir,
+                              const std::vector<std::string>& names) {
   fs::create_directories(dir);
   std::ofstream f(conf);
   for (const auto& n : names)
-    f << "pcm." << n << " {\n  type file\n  slave.pcm { type null }\n  file \"" << (dir / (n + ".raw")).string()
-      << "\"\n  format \"raw\"\n}\n";
+    f << "pcm." << n << " {\n  type file\n  slave.pcm { type null }\n  file \""
+      << (dir / (n + ".raw")).string() << "\"\n  format \"raw\"\n}\n";
 }
 
 inline std::vector<std::int16_t> read_raw(const fs::path& p) {
@@ -36,7 +36,8 @@ inline std::vector<std::int16_t> read_raw(const fs::path& p) {
   const std::vector<char> b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   std::vector<std::int16_t> s(b.size() / 2);
   for (std::size_t i = 0; i < s.size(); ++i)
-    s[i] = static_cast<std::int16_t>(static_cast<unsigned char>(b[2 * i]) | (static_cast<unsigned char>(b[2 * i + 1]) << 8));
+    s[i] = static_cast<std::int16_t>(static_cast<unsigned char>(b[2 * i]) |
+                                     (static_cast<unsigned char>(b[2 * i + 1]) << 8));
   return s;
 }
 

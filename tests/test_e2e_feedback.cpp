@@ -24,9 +24,9 @@ namespace {
 
 const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_feedback_files";
 
-const std::vector<std::string> kStairClips = {"stairs_up", "stairs_down", "step_up",   "step_down", "curb_up",
-                                              "curb_down", "first_step",  "last_step", "end_of_stairs",
-                                              "steps_left", "warning",    "up",        "down"};
+const std::vector<std::string> kStairClips = {
+    "stairs_up", "stairs_down",   "step_up",    "step_down", "curb_up", "curb_down", "first_step",
+    "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down"};
 
 struct Result {
   int code = -1;
@@ -50,8 +50,9 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
       << "\"\n  gpio_chip: \"file:" << edges.string() << "\"\n"
       << extra_yaml;
   }
-  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " + conf.string() +
-                          " --replay " + replay + " --audio " + name + " " + extra_args + " 2>" + err.string();
+  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " +
+                          conf.string() + " --replay " + replay + " --audio " + name + " " + extra_args +
+                          " 2>" + err.string();
   Result r;
   std::FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -146,7 +147,8 @@ TEST(E2eFeedback, StairFreeSequencesSayNothingAboutStairs) {
     EXPECT_EQ(r.cues.front(), "ready") << name;
     for (const auto& c : r.cues) EXPECT_FALSE(stair_token(c)) << name << ": " << c;
     EXPECT_TRUE(sgtest::heard(r.audio, kStairClips).empty()) << name;
-    EXPECT_EQ(sgtest::names_of(sgtest::heard(r.audio, {"ready"})), (std::vector<std::string>{"ready"})) << name;
+    EXPECT_EQ(sgtest::names_of(sgtest::heard(r.audio, {"ready"})), (std::vector<std::string>{"ready"}))
+        << name;
   }
 }
 
@@ -167,6 +169,7 @@ TEST(E2eFeedback, MissingSoundDeviceAndGpioChipDaemonGoesOn) {
   const int st = pclose(p);
   EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 0) << out;
   EXPECT_NE(out.find("cannot open ALSA device 'sg_no_such_pcm'"), std::string::npos) << out;
-  EXPECT_NE(out.find("GPIO chip 'gpiochip_sg_absent' line 17: cannot open the chip"), std::string::npos) << out;
+  EXPECT_NE(out.find("GPIO chip 'gpiochip_sg_absent' line 17: cannot open the chip"), std::string::npos)
+      << out;
   EXPECT_NE(out.find("summary frames=10"), std::string::npos) << out;
 }

@@ -28,7 +28,9 @@ void alsa_setup() {
   setenv("ALSA_CONFIG_PATH", (kDir / "asound.conf").c_str(), 1);
 }
 
-SoundBank bank(float volume = 0.8f) { return load_sound_bank(sgtest::sounds_dir(), all_clip_names(), volume); }
+SoundBank bank(float volume = 0.8f) {
+  return load_sound_bank(sgtest::sounds_dir(), all_clip_names(), volume);
+}
 
 Utterance utt(std::uint64_t id, int priority, std::vector<std::string> clips) {
   Utterance u;
@@ -71,9 +73,9 @@ TEST(FeedbackSounds, MissingAndBadFilesAreNamed) {
   {
     // A valid header of a stereo file.
     std::ofstream f(d / "stereo.wav", std::ios::binary);
-    const unsigned char h[44] = {'R', 'I', 'F', 'F', 40, 0, 0, 0, 'W', 'A', 'V', 'E', 'f', 'm', 't', ' ', 16, 0, 0, 0,
-                                 1, 0, 2, 0, 0x22, 0x56, 0, 0, 0x88, 0x58, 0x01, 0, 4, 0, 16, 0, 'd', 'a', 't', 'a',
-                                 4, 0, 0, 0};
+    const unsigned char h[44] = {'R',  'I', 'F', 'F', 40, 0, 0,   0,   'W', 'A',  'V',  'E', 'f', 'm',  't',
+                                 ' ',  16,  0,   0,   0,  1, 0,   2,   0,   0x22, 0x56, 0,   0,   0x88, 0x58,
+                                 0x01, 0,   4,   0,   16, 0, 'd', 'a', 't', 'a',  4,    0,   0,   0};
     f.write(reinterpret_cast<const char*>(h), 44);
     f.write("\0\0\0\0", 4);
   }
@@ -112,7 +114,8 @@ TEST(FeedbackAlsa, CuesHeardInOrderThroughAFilePcm) {
     // Played in real time (the sink holds itself to the device's pace): ~3.2 s of sound.
     const double expected_s =
         static_cast<double>(sgtest::clip("stairs_up").size() + sgtest::clip("n3").size() +
-                            sgtest::clip("metres").size() + sgtest::clip("last_step").size() + sgtest::clip("tick").size()) /
+                            sgtest::clip("metres").size() + sgtest::clip("last_step").size() +
+                            sgtest::clip("tick").size()) /
         kSoundRate;
     EXPECT_GT(total_s, expected_s - 3 * 0.05 - 0.05);  // each ends a device buffer (50 ms) early
     EXPECT_LT(total_s, expected_s + 1.0);
@@ -122,8 +125,10 @@ TEST(FeedbackAlsa, CuesHeardInOrderThroughAFilePcm) {
   }
   EXPECT_EQ(started, (std::vector<std::uint64_t>{1, 3, 2}));
   const auto cap = sgtest::read_raw(kDir / "sg_order.raw");
-  const auto h = sgtest::heard(cap, {"stairs_up", "stairs_down", "n3", "metres", "tick", "last_step", "first_step"});
-  ASSERT_EQ(sgtest::names_of(h), (std::vector<std::string>{"stairs_up", "n3", "metres", "last_step", "tick"}));
+  const auto h =
+      sgtest::heard(cap, {"stairs_up", "stairs_down", "n3", "metres", "tick", "last_step", "first_step"});
+  ASSERT_EQ(sgtest::names_of(h),
+            (std::vector<std::string>{"stairs_up", "n3", "metres", "last_step", "tick"}));
   // Back to back, each where the previous one ended, starting at the first sample.
   EXPECT_EQ(h[0].pos, 0);
   EXPECT_EQ(h[1].pos, h[0].pos + static_cast<long>(sgtest::clip("stairs_up").size()));
@@ -185,7 +190,7 @@ TEST(FeedbackAlsa, DeviceThatCannotBeOpenedIsNamedAndRetried) {
   const auto c = sink.counters();
   EXPECT_GE(c.open_failures, 3u);  // retried every 0.3 s while there was something to say
   EXPECT_LE(c.open_failures, 6u);
-  EXPECT_EQ(c.stale, 5u);          // dropped once stale, never played late
+  EXPECT_EQ(c.stale, 5u);  // dropped once stale, never played late
   EXPECT_FALSE(c.device_open);
   std::lock_guard<std::mutex> lk(m);
   ASSERT_EQ(warnings.size(), 1u);  // said once, not on every retry

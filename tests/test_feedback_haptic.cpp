@@ -14,7 +14,9 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+double ms(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
 
 /// The edges a pattern should make, as (ms from the first edge, on), on then off per pulse.
 std::vector<std::pair<double, bool>> expected_edges(const HapticPattern& p) {
@@ -40,8 +42,9 @@ CueEvent ev(Cue c, int dir = 0) {
 }  // namespace
 
 TEST(FeedbackHaptic, PatternsEdgesWithin5ms) {
-  for (const CueEvent& e : {ev(Cue::kStairsAhead, 1), ev(Cue::kStairsAhead, -1), ev(Cue::kTick), ev(Cue::kLastStep),
-                            ev(Cue::kDropWarning), ev(Cue::kBlind), ev(Cue::kEndOfStairs)}) {
+  for (const CueEvent& e :
+       {ev(Cue::kStairsAhead, 1), ev(Cue::kStairsAhead, -1), ev(Cue::kTick), ev(Cue::kLastStep),
+        ev(Cue::kDropWarning), ev(Cue::kBlind), ev(Cue::kEndOfStairs)}) {
     auto line = std::make_unique<RecordingLine>();
     RecordingLine* rec = line.get();
     const HapticPattern p = haptic_pattern(e);
@@ -55,7 +58,8 @@ TEST(FeedbackHaptic, PatternsEdgesWithin5ms) {
       EXPECT_EQ(edges[i].on, want[i].second) << token(e) << " edge " << i;
       EXPECT_NEAR(ms(edges[0].t, edges[i].t), want[i].first, 5.0) << token(e) << " edge " << i;
       if (i > 0) {  // each duration too, not only the sum
-        EXPECT_NEAR(ms(edges[i - 1].t, edges[i].t), want[i].first - want[i - 1].first, 5.0) << token(e) << " edge " << i;
+        EXPECT_NEAR(ms(edges[i - 1].t, edges[i].t), want[i].first - want[i - 1].first, 5.0)
+            << token(e) << " edge " << i;
       }
     }
   }
@@ -82,8 +86,7 @@ TEST(FeedbackHaptic, DangerCutsATickAndATickDoesNotCutDanger) {
   EXPECT_FALSE(e[1].on);
   EXPECT_NEAR(ms(e[1].t, e[2].t), 100.0, 5.0);
   const auto want = expected_edges(haptic_pattern(ev(Cue::kDropWarning)));
-  for (std::size_t i = 0; i < want.size(); ++i)
-    EXPECT_NEAR(ms(e[2].t, e[2 + i].t), want[i].first, 5.0) << i;
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_NEAR(ms(e[2].t, e[2 + i].t), want[i].first, 5.0) << i;
   EXPECT_FALSE(e.back().on);
 }
 

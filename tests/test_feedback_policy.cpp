@@ -120,7 +120,8 @@ TEST(FeedbackPolicy, FlickerIsNeverAnnounced) {
     const double t = i * kDt;
     const int in_second = i % 30;
     if (in_second < 3 || in_second == 15)
-      frames.push_back(stair_frame(t, in_second == 15 ? StairKind::kDescending : StairKind::kAscending, 2.5f));
+      frames.push_back(
+          stair_frame(t, in_second == 15 ? StairKind::kDescending : StairKind::kAscending, 2.5f));
     else
       frames.push_back(floor_frame(t));
   }
@@ -135,7 +136,7 @@ TEST(FeedbackPolicy, DropoutDoesNotRetractNorRepeat) {
   std::vector<CueInput> f = approach(0.0, StairKind::kAscending, 3.6f, 1.0);
   for (double t = 1.0; t < 2.0; t += kDt) f.push_back(floor_frame(t));  // 1 s dropout
   for (auto& x : approach(2.0, StairKind::kAscending, 2.6f, 1.0)) f.push_back(x);
-  for (double t = 3.0; t < 8.0; t += kDt) f.push_back(floor_frame(t));  // forgotten (> 3 s)
+  for (double t = 3.0; t < 8.0; t += kDt) f.push_back(floor_frame(t));             // forgotten (> 3 s)
   for (auto& x : approach(8.0, StairKind::kAscending, 3.0f, 1.0)) f.push_back(x);  // < 20 s: not again
   auto s = feed(p, f);
   EXPECT_EQ(count_of(s, Cue::kStairsAhead), 1) << ::testing::PrintToString(toks(s));
@@ -327,8 +328,8 @@ std::vector<CueInput> scripted_flight(int steps, int direction = 1, double step_
 TEST(FeedbackPolicy, ScriptedClimbInOrder) {
   CuePolicy p{FeedbackConfig{}};  // count every 5 steps
   const auto s = feed(p, scripted_flight(8));
-  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m", "first_step", "steps_left:7", "tick",
-                                               "tick", "tick", "count:5", "tick", "last_step", "tick",
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m", "first_step", "steps_left:7",
+                                               "tick", "tick", "tick", "count:5", "tick", "last_step", "tick",
                                                "end_of_stairs"}));
   // Each step cue on the frame its step was reached (0.6 s apart).
   std::vector<double> ticks;
@@ -341,9 +342,9 @@ TEST(FeedbackPolicy, ScriptedDescentWarnsAndCounts) {
   CuePolicy p{FeedbackConfig{}};
   const auto s = feed(p, scripted_flight(4, -1));
   // 3 m -> told; 2 m -> the drop warning; then the flight.
-  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_down:3m", "drop_warning_down:2m",
-                                               "first_step", "steps_left:3", "tick", "last_step", "tick",
-                                               "end_of_stairs"}));
+  EXPECT_EQ(toks(s),
+            (std::vector<std::string>{"ready", "stairs_ahead_down:3m", "drop_warning_down:2m", "first_step",
+                                      "steps_left:3", "tick", "last_step", "tick", "end_of_stairs"}));
 }
 
 TEST(FeedbackPolicy, QuietFlightOnlyTheLastStep) {
@@ -361,10 +362,10 @@ TEST(FeedbackPolicy, VerboseDistancesAndStepsLeft) {
   c.verbosity = "verbose";
   CuePolicy p{c};
   const auto s = feed(p, scripted_flight(12));
-  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m@12", "stairs_ahead_up:1m@12",
-                                               "first_step", "steps_left:11", "tick",
-                                               "tick", "tick", "steps_left:7", "tick", "tick", "tick", "tick",
-                                               "steps_left:2", "last_step", "tick", "end_of_stairs"}));
+  EXPECT_EQ(toks(s),
+            (std::vector<std::string>{"ready", "stairs_ahead_up:3m@12", "stairs_ahead_up:1m@12", "first_step",
+                                      "steps_left:11", "tick", "tick", "tick", "steps_left:7", "tick", "tick",
+                                      "tick", "tick", "steps_left:2", "last_step", "tick", "end_of_stairs"}));
 }
 
 TEST(FeedbackPolicy, WarningCutsTickOnTheSameFrame) {

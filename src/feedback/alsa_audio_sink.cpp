@@ -85,7 +85,9 @@ bool AlsaAudioSink::open_device() {
   pcm_ = p;
   failing_ = false;
   counters_.device_open = true;
-  if (ev_.info) ev_.info("audio: ALSA device '" + opt_.device + "' open (16-bit mono " + std::to_string(kSoundRate) + " Hz)");
+  if (ev_.info)
+    ev_.info("audio: ALSA device '" + opt_.device + "' open (16-bit mono " + std::to_string(kSoundRate) +
+             " Hz)");
   return true;
 }
 
@@ -115,8 +117,8 @@ bool AlsaAudioSink::play_one(const Utterance& u) {
   while (off < buf.size()) {
     {
       std::unique_lock<std::mutex> lk(m_);
-      const double ahead =
-          static_cast<double>(off) / kSoundRate - std::chrono::duration<double>(SteadyClock::now() - t0).count();
+      const double ahead = static_cast<double>(off) / kSoundRate -
+                           std::chrono::duration<double>(SteadyClock::now() - t0).count();
       if (ahead > buffer_s && !cut_ && !stop_) {
         cv_.wait_for(lk, std::chrono::duration<double>(std::min(ahead - buffer_s, 0.02)),
                      [&] { return cut_ || stop_; });
@@ -142,7 +144,8 @@ bool AlsaAudioSink::play_one(const Utterance& u) {
       }
       const int e = snd_pcm_recover(pcm, static_cast<int>(r), 1);
       if (e < 0) {
-        if (ev_.warn) ev_.warn("audio: ALSA device '" + opt_.device + "' failed: " + snd_strerror(e) + "; reopening");
+        if (ev_.warn)
+          ev_.warn("audio: ALSA device '" + opt_.device + "' failed: " + snd_strerror(e) + "; reopening");
         snd_pcm_close(pcm);
         pcm_ = nullptr;
         std::lock_guard<std::mutex> lk(m_);
@@ -164,7 +167,8 @@ bool AlsaAudioSink::play_one(const Utterance& u) {
 
 void AlsaAudioSink::run() {
   auto next_open = SteadyClock::now();
-  const auto retry = std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(opt_.retry_s));
+  const auto retry =
+      std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(opt_.retry_s));
   for (;;) {
     Utterance u;
     {

@@ -10,19 +10,32 @@ bool sayable(int n) { return n >= 1 && n <= kMaxNumber; }
 
 const char* to_string(Cue c) {
   switch (c) {
-    case Cue::kReady: return "ready";
-    case Cue::kCameraLost: return "camera_lost";
-    case Cue::kCameraBack: return "camera_back";
-    case Cue::kBlind: return "blind";
-    case Cue::kStairsAhead: return "stairs_ahead";
-    case Cue::kDropWarning: return "drop_warning";
-    case Cue::kStepAhead: return "step_ahead";
-    case Cue::kFirstStep: return "first_step";
-    case Cue::kTick: return "tick";
-    case Cue::kCount: return "count";
-    case Cue::kStepsLeft: return "steps_left";
-    case Cue::kLastStep: return "last_step";
-    case Cue::kEndOfStairs: return "end_of_stairs";
+    case Cue::kReady:
+      return "ready";
+    case Cue::kCameraLost:
+      return "camera_lost";
+    case Cue::kCameraBack:
+      return "camera_back";
+    case Cue::kBlind:
+      return "blind";
+    case Cue::kStairsAhead:
+      return "stairs_ahead";
+    case Cue::kDropWarning:
+      return "drop_warning";
+    case Cue::kStepAhead:
+      return "step_ahead";
+    case Cue::kFirstStep:
+      return "first_step";
+    case Cue::kTick:
+      return "tick";
+    case Cue::kCount:
+      return "count";
+    case Cue::kStepsLeft:
+      return "steps_left";
+    case Cue::kLastStep:
+      return "last_step";
+    case Cue::kEndOfStairs:
+      return "end_of_stairs";
   }
   return "?";
 }
@@ -31,19 +44,26 @@ int cue_priority(Cue c) {
   // Step feedback is the lowest (a newer step makes an old tick stale); what is ahead comes next;
   // the system's own blindness and the last step are warnings; a drop ahead is the highest.
   switch (c) {
-    case Cue::kTick: return 1;
-    case Cue::kCount: return 2;
-    case Cue::kReady: return 3;
+    case Cue::kTick:
+      return 1;
+    case Cue::kCount:
+      return 2;
+    case Cue::kReady:
+      return 3;
     case Cue::kStairsAhead:
     case Cue::kStepAhead:
     case Cue::kFirstStep:
     case Cue::kStepsLeft:
     case Cue::kEndOfStairs:
-    case Cue::kCameraBack: return 4;
+    case Cue::kCameraBack:
+      return 4;
     case Cue::kLastStep:
-    case Cue::kBlind: return 6;
-    case Cue::kCameraLost: return 7;
-    case Cue::kDropWarning: return 8;
+    case Cue::kBlind:
+      return 6;
+    case Cue::kCameraLost:
+      return 7;
+    case Cue::kDropWarning:
+      return 8;
   }
   return 0;
 }
@@ -84,10 +104,18 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     }
   };
   switch (e.cue) {
-    case Cue::kReady: c = {"ready"}; break;
-    case Cue::kCameraLost: c = {"camera_lost"}; break;
-    case Cue::kCameraBack: c = {"camera_back"}; break;
-    case Cue::kBlind: c = {"cannot_see"}; break;
+    case Cue::kReady:
+      c = {"ready"};
+      break;
+    case Cue::kCameraLost:
+      c = {"camera_lost"};
+      break;
+    case Cue::kCameraBack:
+      c = {"camera_back"};
+      break;
+    case Cue::kBlind:
+      c = {"cannot_see"};
+      break;
     case Cue::kStairsAhead:
       if (e.earcon_only) {
         c = {up ? "up" : "down"};
@@ -108,8 +136,12 @@ std::vector<std::string> clips_for(const CueEvent& e) {
       else
         c = {up ? "step_up" : "step_down"};
       break;
-    case Cue::kFirstStep: c = {"first_step"}; break;
-    case Cue::kTick: c = {"tick"}; break;
+    case Cue::kFirstStep:
+      c = {"first_step"};
+      break;
+    case Cue::kTick:
+      c = {"tick"};
+      break;
     case Cue::kCount:
       if (sayable(e.number))
         c = {number_clip(e.number)};
@@ -119,19 +151,22 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kStepsLeft:
       if (sayable(e.number)) c = {number_clip(e.number), "steps_left"};
       break;
-    case Cue::kLastStep: c = {"last_step"}; break;
-    case Cue::kEndOfStairs: c = {"end_of_stairs"}; break;
+    case Cue::kLastStep:
+      c = {"last_step"};
+      break;
+    case Cue::kEndOfStairs:
+      c = {"end_of_stairs"};
+      break;
   }
   return c;
 }
 
 const std::vector<std::string>& all_clip_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"ready",      "camera_lost", "camera_back", "cannot_see",    "stairs_up",
-                                  "stairs_down", "step_up",    "step_down",   "curb_up",       "curb_down",
-                                  "first_step", "last_step",   "end_of_stairs", "steps_left",  "metre",
-                                  "metres",     "oclock",      "tick",        "up",            "down",
-                                  "warning"};
+    std::vector<std::string> n = {
+        "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
+        "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
+        "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

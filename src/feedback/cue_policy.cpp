@@ -50,8 +50,10 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kDropWarning:
     case Cue::kLastStep:
     case Cue::kStairsAhead:  // as an earcon
-    case Cue::kStepAhead: return true;
-    default: return false;
+    case Cue::kStepAhead:
+      return true;
+    default:
+      return false;
   }
 }
 
@@ -62,10 +64,14 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kCameraLost:
     case Cue::kCameraBack:
     case Cue::kReady:
-    case Cue::kCount: return true;
-    case Cue::kTick: return t - last >= cfg_.min_tick_interval;
-    case Cue::kBlind: return t - last >= cfg_.blind_repeat;
-    default: return t - last >= cfg_.min_cue_interval;
+    case Cue::kCount:
+      return true;
+    case Cue::kTick:
+      return t - last >= cfg_.min_tick_interval;
+    case Cue::kBlind:
+      return t - last >= cfg_.blind_repeat;
+    default:
+      return t - last >= cfg_.min_cue_interval;
   }
 }
 
@@ -226,7 +232,8 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
   Sighting s;
   if (tr.ran && tr.state == TraversalState::kStairAhead && tr.kind != StairKind::kNone) {
     s = Sighting{true, tr.kind, tr.direction, tr.distance_m, tr.bearing_rad};
-  } else if (in.stair.detected && !(tr.ran && (on_flight(tr.state) || tr.state == TraversalState::kArrived))) {
+  } else if (in.stair.detected &&
+             !(tr.ran && (on_flight(tr.state) || tr.state == TraversalState::kArrived))) {
     s = Sighting{true, in.stair.kind, in.stair.direction, in.stair.distance_m, in.stair.bearing_rad};
   }
   if (s.present && s.kind == StairKind::kNone) s.present = false;

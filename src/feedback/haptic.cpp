@@ -1,7 +1,6 @@
 #include "stairguide/feedback/haptic.hpp"
 
 #include <gpiod.hpp>
-
 #include <stdexcept>
 #include <system_error>
 
@@ -15,15 +14,22 @@ HapticPattern haptic_pattern(const CueEvent& e) {
       return {{250, 120}, {80, 0}};
     case Cue::kTick:
     case Cue::kFirstStep:
-    case Cue::kCount: return {{60, 0}};
-    case Cue::kLastStep: return {{600, 0}};
-    case Cue::kEndOfStairs: return {{60, 100}, {60, 0}};
-    case Cue::kDropWarning: return {{70, 70}, {70, 70}, {70, 70}, {70, 70}, {70, 0}};
+    case Cue::kCount:
+      return {{60, 0}};
+    case Cue::kLastStep:
+      return {{600, 0}};
+    case Cue::kEndOfStairs:
+      return {{60, 100}, {60, 0}};
+    case Cue::kDropWarning:
+      return {{70, 70}, {70, 70}, {70, 70}, {70, 70}, {70, 0}};
     case Cue::kBlind:
-    case Cue::kCameraLost: return {{300, 200}, {300, 200}, {300, 0}};
+    case Cue::kCameraLost:
+      return {{300, 200}, {300, 200}, {300, 0}};
     case Cue::kReady:
-    case Cue::kCameraBack: return {{150, 0}};
-    case Cue::kStepsLeft: return {};  // a number: spoken only
+    case Cue::kCameraBack:
+      return {{150, 0}};
+    case Cue::kStepsLeft:
+      return {};  // a number: spoken only
   }
   return {};
 }

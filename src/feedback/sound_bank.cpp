@@ -79,7 +79,8 @@ SoundBank load_sound_bank(const std::string& dir, const std::vector<std::string>
       continue;
     }
     if (rate != kSoundRate) {
-      bank.problems.push_back(path + ": " + std::to_string(rate) + " Hz, expected " + std::to_string(kSoundRate));
+      bank.problems.push_back(path + ": " + std::to_string(rate) + " Hz, expected " +
+                              std::to_string(kSoundRate));
       continue;
     }
     if (g != 1.f)

@@ -46,9 +46,10 @@ struct FeedbackStage::Impl {
     if (f.audio_enabled) {
       bank = fb::load_sound_bank(f.sounds_dir, fb::all_clip_names(), f.volume);
       if (bank.clips.empty())
-        spdlog::error("audio: no usable sound in '{}' (feedback.sounds_dir; {}): cues are silent, the buzzer "
-                      "goes on",
-                      f.sounds_dir, bank.problems.empty() ? std::string("empty") : bank.problems.front());
+        spdlog::error(
+            "audio: no usable sound in '{}' (feedback.sounds_dir; {}): cues are silent, the buzzer "
+            "goes on",
+            f.sounds_dir, bank.problems.empty() ? std::string("empty") : bank.problems.front());
       else
         for (const auto& p : bank.problems) spdlog::error("audio: sound {}: that cue is silent", p);
     }
@@ -76,7 +77,8 @@ struct FeedbackStage::Impl {
         haptic = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
         spdlog::info("haptic: buzzer on {}", haptic->describe());
       } catch (const std::exception& e) {
-        spdlog::error("{}; going on with audio only (feedback.haptic_enabled: false silences this)", e.what());
+        spdlog::error("{}; going on with audio only (feedback.haptic_enabled: false silences this)",
+                      e.what());
       }
     }
   }
@@ -145,10 +147,10 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
   const FeedbackConfig& a = impl_->config.feedback;
   const FeedbackConfig& b = config.feedback;
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
-  if (impl_->sinks_open && (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir ||
-                            a.volume != b.volume || a.audio_enabled != b.audio_enabled ||
-                            a.haptic_enabled != b.haptic_enabled || a.gpio_chip != b.gpio_chip ||
-                            a.gpio_line != b.gpio_line))
+  if (impl_->sinks_open &&
+      (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
+       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
+       a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line))
     spdlog::info("feedback: sound device, sounds and buzzer settings apply at the next start");
   PipelineConfig keep = config;
   const FeedbackConfig old = impl_->config.feedback;
