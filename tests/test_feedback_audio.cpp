@@ -196,3 +196,37 @@ TEST(FeedbackAlsa, DeviceThatCannotBeOpenedIsNamedAndRetried) {
   ASSERT_EQ(warnings.size(), 1u);  // said once, not on every retry
   EXPECT_NE(warnings[0].find("cannot open ALSA device 'sg_no_such_pcm'"), std::string::npos) << warnings[0];
 }
+
+TEST(FeedbackAlsa, DeviceThatAppearsLaterIsOpenedAtTheNextRetry) {
+  alsa_setup();
+  std::vector<std::string> info;
+  std::mutex m;
+  AudioEvents ev;
+  ev.info = [&](const std::string& s) {
+    std::lock_guard<std::mutex> lk(m);
+    info.push_back(s);
+  };
+  AlsaSinkOptions o;
+  o.device = "sg_late";
+  o.retry_s = 0.3;
+  o.max_age_s = 10.0;
+  fs::remove(kDir / "sg_late.raw");
+  {
+    AlsaAudioSink sink(o, bank(), ev);
+    sink.play(utt(1, 4, {"camera_back"}));
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    EXPECT_GE(sink.counters().open_failures, 1u);
+    // The device comes (ALSA reads its configuration again when the file changes).
+    sgtest::write_alsa_config(kDir / "asound.conf", kDir, {"sg_order", "sg_cut", "sg_latency", "sg_late"});
+    ASSERT_TRUE(sink.drain(std::chrono::seconds(5)));
+    EXPECT_TRUE(sink.counters().device_open);
+    EXPECT_EQ(sink.counters().played, 1u);
+    {
+      std::lock_guard<std::mutex> lk(m);
+      ASSERT_EQ(info.size(), 1u);
+      EXPECT_NE(info[0].find("'sg_late' open"), std::string::npos) << info[0];
+    }
+  }  // closed: the file PCM has written everything
+  const auto h = sgtest::heard(sgtest::read_raw(kDir / "sg_late.raw"), {"camera_back", "camera_lost"});
+  EXPECT_EQ(sgtest::names_of(h), (std::vector<std::string>{"camera_back"}));
+}
