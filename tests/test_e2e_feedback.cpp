@@ -99,13 +99,17 @@ TEST(E2eFeedback, ApproachAndClimbSaysStairsAheadGoingUpFirst) {
   // Heard: "stairs ahead, going up" before anything else about stairs ("ready", said at the first
   // frame, is cut by it when the stairs are in view from the start: it is the more urgent).
   const auto names = sgtest::names_of(sgtest::heard(r.audio, kStairClips));
+  std::printf("climb: cues %s; heard %s\n", ::testing::PrintToString(r.cues).c_str(),
+              ::testing::PrintToString(names).c_str());
   ASSERT_FALSE(names.empty()) << r.log;
   EXPECT_EQ(names[0], "stairs_up") << ::testing::PrintToString(names);
-  // Felt: the ready pulse, then the rising pair (short-long) of stairs going up.
+  // Felt: the ready pulse, then the rising pair (short-long) of stairs going up. Within 15 ms here:
+  // the buzzer thread shares two cores with the whole pipeline (and the other tests); its own
+  // timing, 5 ms, is test_feedback_haptic's.
   ASSERT_GE(r.edges.size(), 6u);
-  EXPECT_NEAR(r.edges[1].first - r.edges[0].first, 150.0, 5.0);
-  EXPECT_NEAR(r.edges[3].first - r.edges[2].first, 80.0, 5.0);
-  EXPECT_NEAR(r.edges[5].first - r.edges[4].first, 250.0, 5.0);
+  EXPECT_NEAR(r.edges[1].first - r.edges[0].first, 150.0, 15.0);
+  EXPECT_NEAR(r.edges[3].first - r.edges[2].first, 80.0, 15.0);
+  EXPECT_NEAR(r.edges[5].first - r.edges[4].first, 250.0, 15.0);
   EXPECT_NE(r.summary.find(" cues="), std::string::npos) << r.summary;
 }
 
@@ -126,6 +130,8 @@ TEST(E2eFeedback, DescentWarns) {
     }
   EXPECT_EQ(warnings, 1) << ::testing::PrintToString(r.cues);
   const auto names = sgtest::names_of(sgtest::heard(r.audio, kStairClips));
+  std::printf("descent: cues %s; heard %s\n", ::testing::PrintToString(r.cues).c_str(),
+              ::testing::PrintToString(names).c_str());
   ASSERT_FALSE(names.empty());
   EXPECT_TRUE(names[0] == "stairs_down" || names[0] == "warning") << ::testing::PrintToString(names);
   EXPECT_NE(std::find(names.begin(), names.end(), "warning"), names.end()) << ::testing::PrintToString(names);
