@@ -198,6 +198,24 @@ TEST(FeedbackPolicy, DescendingWithinDangerDistanceAlwaysWarnsEvenQuiet) {
   EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "drop_warning_down"}));
 }
 
+TEST(FeedbackPolicy, DropWarnedAgainOnlyAfterItWasForgotten) {
+  FeedbackConfig c;  // forget 3 s, repeat 20 s
+  CuePolicy p{c};
+  std::vector<CueInput> f = approach(0.0, StairKind::kDescending, 1.8f, 1.0);
+  for (double t = 1.0; t < 2.5; t += kDt) f.push_back(floor_frame(t));  // 1.5 s dropout: held
+  for (auto& x : approach(2.5, StairKind::kDescending, 1.5f, 0.5)) f.push_back(x);
+  auto s = feed(p, f);
+  EXPECT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
+  // Out of mind for 4 s (forgotten), back within 2 m, 5 s after the warning: warned again.
+  std::vector<CueInput> g;
+  for (double t = 3.0; t < 7.0; t += kDt) g.push_back(floor_frame(t));
+  for (auto& x : approach(7.0, StairKind::kDescending, 1.5f, 1.0)) g.push_back(x);
+  s = feed(p, g);
+  ASSERT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
+  EXPECT_NEAR(s.back().t, 7.0 + c.confirm_time, kDt + 1e-6);
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 0);
+}
+
 TEST(FeedbackPolicy, CurbsAndSingleSteps) {
   CuePolicy p{FeedbackConfig{}};
   auto s = feed(p, approach(0.0, StairKind::kCurb, 2.0f, 1.0));

@@ -117,6 +117,8 @@ void CuePolicy::detection_cues(const Sighting& s, double t, std::vector<CueEvent
       told_ = Told{};
       told_.key = key;
     }
+    // A drop ahead is warned of again once it has been out of mind (forgotten) and comes back.
+    told_.warned = false;
     told_.active = true;
     told_.last_seen_t = t;
     cand_.active = false;

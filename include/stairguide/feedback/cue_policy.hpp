@@ -11,7 +11,8 @@
 /// - Rate limits: one cue of a kind per `min_cue_interval` s; ticks at most one per
 ///   `min_tick_interval` s.
 /// - A descending staircase within `danger_distance` m (or of unknown distance) always warns,
-///   whatever the verbosity.
+///   whatever the verbosity: once while it is held, again when it comes back after being forgotten
+///   (even within `repeat_time`).
 /// - Blind: no floor and nothing seen nor tracked for `blind_after` s: told once, then every
 ///   `blind_repeat` s while it lasts.
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
