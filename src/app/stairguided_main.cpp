@@ -28,6 +28,7 @@ using namespace stairguide;
 constexpr const char* kUsage =
     "usage: stairguided [--config FILE] [--replay FILE.oni|DIR|synth:SCENE[:FRAMES[:SEED[:NOISE]]]]\n"
     "                   [--realtime|--fast] [--sync] [--frames N] [--no-frame-lines]\n"
+    "                   [--audio DEVICE] [--no-haptic]\n"
     "       stairguided --check-config FILE\n"
     "\n"
     "Runs the stair guidance pipeline on the live camera (default) or on a recording.\n"
@@ -38,6 +39,8 @@ constexpr const char* kUsage =
     "  --sync              one thread: every stage on every frame, in order\n"
     "  --frames N          stop after N frames\n"
     "  --no-frame-lines    no per-frame lines on stdout\n"
+    "  --audio DEVICE      play the cues on ALSA PCM DEVICE (overrides feedback.audio_device)\n"
+    "  --no-haptic         no buzzer (overrides feedback.haptic_enabled)\n"
     "  --check-config FILE validate FILE and exit (0 when valid)\n"
     "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the config file.\n";
 
@@ -49,7 +52,18 @@ struct Args {
   bool sync = false;
   bool frame_lines = true;
   long frames = -1;
+  std::string audio;  // --audio DEVICE, empty: the config's
+  bool no_haptic = false;
 };
+
+/// The command line's feedback overrides, applied to the config at start and to every reload.
+void apply_overrides(const Args& a, PipelineConfig& c) {
+  if (!a.audio.empty()) {
+    c.feedback.audio_device = a.audio;
+    c.feedback.audio_enabled = true;
+  }
+  if (a.no_haptic) c.feedback.haptic_enabled = false;
+}
 
 bool parse_args(int argc, char** argv, Args& a, std::string& err) {
   for (int i = 1; i < argc; ++i) {
@@ -74,6 +88,10 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
       a.pacing = 2;
     } else if (s == "--sync") {
       a.sync = true;
+    } else if (s == "--audio") {
+      if (!value(a.audio)) return false;
+    } else if (s == "--no-haptic") {
+      a.no_haptic = true;
     } else if (s == "--no-frame-lines") {
       a.frame_lines = false;
     } else if (s == "--frames") {
@@ -141,6 +159,7 @@ int main(int argc, char** argv) {
     spdlog::critical("config error: {}", e.what());
     return 3;
   }
+  apply_overrides(args, config);
   runtime::set_log_level(config.runtime.log_level);
   spdlog::info("stairguided starting: config {}",
                args.config_path.empty() ? "(built-in defaults)" : args.config_path);
@@ -181,7 +200,8 @@ int main(int argc, char** argv) {
           continue;
         }
         try {
-          const PipelineConfig fresh = load_config(args.config_path);
+          PipelineConfig fresh = load_config(args.config_path);
+          apply_overrides(args, fresh);
           rt.reconfigure(fresh);
           spdlog::info("SIGHUP: config reloaded from {} (generation {})", args.config_path,
                        rt.stats().config_generation);
@@ -213,13 +233,16 @@ int main(int argc, char** argv) {
   if (replay && args.frame_lines) {
     std::printf(
         "summary frames=%llu odometry_frames=%llu odometry_lost=%llu perception_frames=%llu "
-        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s\n",
+        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s cues=%llu "
+        "cues_sounded=%llu cue_latency_p50_ms=%.2f cue_latency_p99_ms=%.2f last_cue=%s\n",
         static_cast<unsigned long long>(st.frames_captured),
         static_cast<unsigned long long>(st.odometry_frames),
         static_cast<unsigned long long>(st.odometry_frames_lost),
         static_cast<unsigned long long>(st.perception_frames),
         static_cast<unsigned long long>(st.perception_skipped), st.fps, st.latency_p50_ms, st.latency_p99_ms,
-        st.state.c_str());
+        st.state.c_str(), static_cast<unsigned long long>(st.cues),
+        static_cast<unsigned long long>(st.cues_sounded), st.cue_latency_p50_ms, st.cue_latency_p99_ms,
+        st.last_cue.empty() ? "-" : st.last_cue.c_str());
   }
   std::fflush(stdout);
   spdlog::default_logger()->flush();

@@ -204,32 +204,7 @@ std::string PerceptionStage::describe() const {
   return "Perception+StairStage(traversal=none, seam: no traversal stage in the library)";
 }
 
-// ---------------------------------------------------------------------------------------------
-// Feedback. SEAM: the feedback room (cue policy, audio, haptic) is not in this build; the decision
-// is the perceived state itself and no cue is played.
-struct FeedbackStage::Impl {
-  PipelineConfig config;
-  std::string last_state = "none";
-};
-
-FeedbackStage::FeedbackStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>()) {
-  impl_->config = config;
-}
-FeedbackStage::~FeedbackStage() = default;
-
-Decision FeedbackStage::decide(const PerceptionOutput& perception,
-                               const OdometryOutput* /*latest_odometry*/) {
-  Decision d;
-  d.state = perception.state;
-  d.changed = d.state != impl_->last_state;
-  impl_->last_state = d.state;
-  return d;
-}
-void FeedbackStage::camera_lost(const std::string& /*why*/) {}
-void FeedbackStage::camera_back() {}
-void FeedbackStage::reconfigure(const PipelineConfig& config) { impl_->config = config; }
-bool FeedbackStage::available() const { return false; }
-std::string FeedbackStage::describe() const { return "none(seam: feedback room not built)"; }
+// Feedback: src/runtime/feedback_stage.cpp.
 
 std::string describe_stages(const PipelineConfig& config) {
   return "odometry=" + OdometryStage(config).describe() +

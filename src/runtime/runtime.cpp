@@ -59,6 +59,7 @@ struct PercMsg {
   Clock::time_point captured{};
   std::uint64_t config_generation = 1;
   double latency_ms = -1.0;  ///< capture -> decision, set when the decision is made
+  std::string cue;           ///< cues given on this frame (feedback tokens), empty for none
 };
 
 /// Wake-up signal between two threads; carries no data.
@@ -120,13 +121,15 @@ std::string RuntimeStats::summary() const {
   std::snprintf(
       buf, sizeof buf,
       "%s: %llu frames, %.1f fps, odometry %llu (failed %llu, lost %llu), perception %llu "
-      "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, camera lost %llu, cfg %llu",
+      "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, camera lost %llu, cfg %llu, "
+      "cues %llu (last %s)",
       state.c_str(), static_cast<unsigned long long>(frames_captured), fps,
       static_cast<unsigned long long>(odometry_frames), static_cast<unsigned long long>(odometry_failures),
       static_cast<unsigned long long>(odometry_frames_lost),
       static_cast<unsigned long long>(perception_frames), perception_fps,
       static_cast<unsigned long long>(perception_skipped), drop_pct, latency_p50_ms, latency_p99_ms,
-      static_cast<unsigned long long>(camera_losses), static_cast<unsigned long long>(config_generation));
+      static_cast<unsigned long long>(camera_losses), static_cast<unsigned long long>(config_generation),
+      static_cast<unsigned long long>(cues), last_cue.empty() ? "-" : last_cue.c_str());
   return buf;
 }
 
@@ -601,7 +604,8 @@ struct Runtime::Impl {
 
   void on_perception(PercMsg& m) {
     const OdometryOutput* odo = have_last_odometry ? &last_odometry : nullptr;
-    const Decision d = feedback->decide(m.out, odo);
+    const Decision d = feedback->decide(m.out, odo, m.timestamp, m.captured);
+    m.cue = d.cue;
     const auto now = Clock::now();
     const double lat = ms_between(m.captured, now);
     m.latency_ms = lat;
@@ -614,7 +618,7 @@ struct Runtime::Impl {
     }
     decisions.fetch_add(1);
     if (d.changed) spdlog::info("frame {}: state {} ({})", m.out.seq, d.state, m.out.detail);
-    if (!d.cue.empty()) spdlog::debug("frame {}: cue {}", m.out.seq, d.cue);
+    if (!d.cue.empty()) spdlog::info("frame {}: cue {}", m.out.seq, d.cue);
     perc_pending.push_back(std::move(m));
   }
 
@@ -649,10 +653,12 @@ struct Runtime::Impl {
     if (o) std::snprintf(oms, sizeof oms, "%.2f", o->out.ms);
     std::fprintf(
         opt.frame_out,
-        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s\n",
+        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s"
+        " cue=%s\n",
         static_cast<unsigned long long>(seq), ts, odom.c_str(), p ? token(p->out.state).c_str() : "skipped",
         static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms,
-        !p ? "-" : !p->out.manhattan_found ? "none" : p->out.manhattan_carried ? "carried" : "seen");
+        !p ? "-" : !p->out.manhattan_found ? "none" : p->out.manhattan_carried ? "carried" : "seen",
+        p && !p->cue.empty() ? p->cue.c_str() : "-");
     std::fflush(opt.frame_out);
   }
 
@@ -774,6 +780,7 @@ struct Runtime::Impl {
       if (stop.load()) break;
       if (odo_finished && perc_finished && odo_out->empty() && perc_out->empty()) {
         emit_lines(perc_taken, true, true);
+        feedback->drain(Ms(3000));  // the input ended: let the last cues be heard
         break;
       }
       if (!got) {
@@ -825,6 +832,12 @@ struct Runtime::Impl {
     s.latency_p50_ms = latency.percentile(50);
     s.latency_p99_ms = latency.percentile(99);
     s.latency_max_ms = latency.max();
+    const FeedbackStage::CueLatency cl = feedback->cue_latency();
+    s.cues = cl.cues;
+    s.cues_sounded = cl.sounded;
+    s.cue_latency_p50_ms = cl.p50_ms;
+    s.cue_latency_p99_ms = cl.p99_ms;
+    s.last_cue = cl.last;
     if (have_first && have_last) s.elapsed_s = std::max(0.0, seconds_between(first_capture, last_decision));
     if (s.elapsed_s > 0) {
       s.fps = static_cast<double>(s.odometry_frames) / s.elapsed_s;
@@ -928,6 +941,7 @@ int Runtime::run() {
     m.maybe_report();
   }
   m.emit_lines(m.next_seq, true, true);
+  if (!m.stop.load()) m.feedback->drain(Ms(3000));  // the input ended: let the last cues be heard
   m.source.reset();
   for (auto& d : m.done) d.store(true);
   return exit_code();

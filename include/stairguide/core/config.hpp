@@ -572,10 +572,21 @@ struct FeedbackConfig {
   std::string sounds_dir = "/usr/share/stairguide/sounds";
   float volume = 0.8f;                    ///< fraction of full scale
   bool haptic_enabled = true;
-  std::string gpio_chip = "gpiochip0";
+  std::string gpio_chip = "gpiochip0";    ///< name or /dev path; "file:PATH" writes the edges to PATH (tests)
   int gpio_line = 17;
   float min_cue_interval = 1.5f;          ///< s between two cues of the same kind
   float announce_distance = 4.0f;         ///< m, announce stairs nearer than this
+  std::string verbosity = "normal";       ///< "quiet", "normal" or "verbose"
+  float danger_distance = 2.0f;           ///< m, a descending staircase nearer than this always warns
+  int confirm_frames = 4;                 ///< frames a detection needs before it is announced
+  float confirm_time = 0.3f;              ///< s a detection must persist before it is announced
+  float forget_time = 3.0f;               ///< s unseen before an announced staircase is forgotten
+  float repeat_time = 20.0f;              ///< s before the same staircase may be announced again
+  float blind_after = 3.0f;               ///< s with no floor and no stair before "cannot see"
+  float blind_repeat = 30.0f;             ///< s between two "cannot see" cues while still blind
+  int count_interval = 5;                 ///< steps between two spoken counts on a flight
+  float min_tick_interval = 0.25f;        ///< s, shortest gap between two step ticks
+  float audio_retry = 3.0f;               ///< s between two attempts to open the sound device
 
   template <class V> void visit(V& v) {
     v.flag(audio_enabled, "audio_enabled", "play audio cues");
@@ -583,10 +594,22 @@ struct FeedbackConfig {
     v.text(sounds_dir, "sounds_dir", {}, "folder of the WAV cues");
     v.num(volume, "volume_percent", Unit::kPercent, 0, 100, "cue volume");
     v.flag(haptic_enabled, "haptic_enabled", "drive the buzzer on the GPIO line");
-    v.text(gpio_chip, "gpio_chip", {}, "GPIO chip of the buzzer (name or /dev path)");
+    v.text(gpio_chip, "gpio_chip", {}, "GPIO chip of the buzzer (name or /dev path; file:PATH records the edges)");
     v.num(gpio_line, "gpio_line", Unit::kCount, 0, 1023, "GPIO line offset of the buzzer");
     v.num(min_cue_interval, "min_cue_interval_s", Unit::kSecond, 0, 60, "shortest gap between two cues of one kind");
     v.num(announce_distance, "announce_distance_m", Unit::kMetre, 0.2, 20, "announce stairs nearer than this");
+    v.text(verbosity, "verbosity", {"quiet", "normal", "verbose"},
+           "quiet: warnings only (earcons for stairs ahead); normal: + speech, ticks, counts; verbose: + distances, steps left");
+    v.num(danger_distance, "danger_distance_m", Unit::kMetre, 0.5, 10, "a descending staircase nearer than this always warns");
+    v.num(confirm_frames, "confirm_frames", Unit::kCount, 1, 100, "frames a detection needs before it is announced");
+    v.num(confirm_time, "confirm_time_s", Unit::kSecond, 0, 10, "a detection must persist this long before it is announced");
+    v.num(forget_time, "forget_time_s", Unit::kSecond, 0.1, 60, "an announced staircase unseen this long is forgotten");
+    v.num(repeat_time, "repeat_time_s", Unit::kSecond, 0, 600, "the same staircase is announced again after this long");
+    v.num(blind_after, "blind_after_s", Unit::kSecond, 0.1, 600, "no floor and no stair this long: tell the user it cannot see");
+    v.num(blind_repeat, "blind_repeat_s", Unit::kSecond, 1, 3600, "while blind, tell it again at this interval");
+    v.num(count_interval, "count_interval_steps", Unit::kCount, 1, 100, "steps between two spoken counts on a flight");
+    v.num(min_tick_interval, "min_tick_interval_s", Unit::kSecond, 0, 5, "shortest gap between two step ticks");
+    v.num(audio_retry, "audio_retry_s", Unit::kSecond, 0.1, 600, "seconds between attempts to open the sound device");
   }
 };
 

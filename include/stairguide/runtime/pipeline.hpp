@@ -13,6 +13,7 @@
 /// not thread-safe: each is driven by one thread. `reconfigure()` is called by that same thread
 /// between two frames.
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -129,13 +130,29 @@ class FeedbackStage {
   FeedbackStage(const FeedbackStage&) = delete;
   FeedbackStage& operator=(const FeedbackStage&) = delete;
 
-  Decision decide(const PerceptionOutput& perception, const OdometryOutput* latest_odometry);
+  /// `timestamp_s`: the frame's timestamp (the policy's clock: a replay at any speed gives the
+  /// same cues); `captured`: when it was captured (the cue latency is measured from it).
+  Decision decide(const PerceptionOutput& perception, const OdometryOutput* latest_odometry,
+                  double timestamp_s = 0.0,
+                  std::chrono::steady_clock::time_point captured = std::chrono::steady_clock::now());
   /// The camera stopped sending (`why` names it) / is back: the user must be told.
   void camera_lost(const std::string& why);
   void camera_back();
   void reconfigure(const PipelineConfig& config);
   bool available() const;
   std::string describe() const;
+  /// Plays out what is queued, at most `timeout` (end of a replay).
+  void drain(std::chrono::milliseconds timeout);
+
+  /// Capture of the frame that warranted a cue -> its first sample handed to the sound device.
+  struct CueLatency {
+    std::uint64_t cues = 0;     ///< cues given (all sinks)
+    std::uint64_t sounded = 0;  ///< of them, started on the sound device
+    double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
+    std::string last;  ///< token of the last cue given ("" none)
+  };
+  CueLatency cue_latency() const;  ///< any thread
+  void clear_cue_latency();         ///< forgets the latencies measured so far (benchmarks)
 
  private:
   struct Impl;

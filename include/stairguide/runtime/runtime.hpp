@@ -74,6 +74,11 @@ struct RuntimeStats {
   double latency_max_ms = 0.0;
   double odometry_ms_mean = 0.0;  ///< mean time in the odometry stage
   double perception_ms_mean = 0.0;
+  std::uint64_t cues = 0;          ///< cues given to the user (feedback)
+  std::uint64_t cues_sounded = 0;  ///< of them, started on the sound device
+  double cue_latency_p50_ms = 0.0; ///< capture of the frame warranting a cue -> its first sample out
+  double cue_latency_p99_ms = 0.0;
+  std::string last_cue;            ///< token of the last cue ("" none)
   /// The systemd STATUS= text / log line for these counters.
   std::string summary() const;
 };

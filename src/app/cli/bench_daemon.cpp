@@ -5,10 +5,17 @@
 //      odometry (odometry_frames_lost must be 0);
 //   3. real-time replay at the recording's 30 Hz, threaded: capture-to-decision latency p50/p99 and
 //      the share of frames perception skipped.
+//   4. the cue path: the feedback stage driven at 30 Hz with a cue (a step tick) every third frame,
+//      from the decision to the cue's first sample handed to the sound device (`--audio DEV`,
+//      default ALSA's "null"; the buzzer is off in every run).
 // Top-level JSON keys: fps (2), latency_p50_ms / latency_p99_ms / perception_drop_rate (3),
-// odometry_frames_lost (2 + 3); each run in full under "fast", "realtime", "reference".
+// cue_latency_p50_ms / cue_latency_p99_ms (3: capture of the frame warranting a cue -> its first
+// sample out), odometry_frames_lost (2 + 3); each run in full under "fast", "realtime",
+// "reference", "cue_path".
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <thread>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +25,7 @@
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/runtime/logging.hpp"
+#include "stairguide/runtime/pipeline.hpp"
 #include "stairguide/runtime/runtime.hpp"
 
 namespace stairguide::cli {
@@ -83,14 +91,16 @@ std::string run_json(const Run& r) {
       "\"latency_max_ms\": %.2f, \"odometry_frames\": %llu, \"odometry_frames_lost\": %llu, "
       "\"odometry_failures\": %llu, \"perception_frames\": %llu, \"perception_skipped\": %llu, "
       "\"perception_drop_rate\": %.4f, \"perception_fps\": %.2f, \"odometry_ms_mean\": %.2f, "
-      "\"perception_ms_mean\": %.2f, \"wall_s\": %.2f}",
+      "\"perception_ms_mean\": %.2f, \"cues\": %llu, \"cues_sounded\": %llu, \"cue_latency_p50_ms\": %.2f, "
+      "\"cue_latency_p99_ms\": %.2f, \"wall_s\": %.2f}",
       static_cast<unsigned long long>(s.frames_captured), s.fps, s.latency_p50_ms, s.latency_p99_ms,
       s.latency_max_ms, static_cast<unsigned long long>(s.odometry_frames),
       static_cast<unsigned long long>(s.odometry_frames_lost + (s.frames_captured - s.odometry_frames)),
       static_cast<unsigned long long>(s.odometry_failures),
       static_cast<unsigned long long>(s.perception_frames),
       static_cast<unsigned long long>(s.perception_skipped), s.perception_drop_rate, s.perception_fps,
-      s.odometry_ms_mean, s.perception_ms_mean, r.wall_s);
+      s.odometry_ms_mean, s.perception_ms_mean, static_cast<unsigned long long>(s.cues),
+      static_cast<unsigned long long>(s.cues_sounded), s.cue_latency_p50_ms, s.cue_latency_p99_ms, r.wall_s);
   return buf;
 }
 
@@ -98,13 +108,47 @@ void print_run(const char* name, const Run& r) {
   const auto& s = r.stats;
   std::printf(
       "%-22s %5llu frames  %7.1f fps  latency p50 %6.1f ms  p99 %6.1f ms  odometry %llu lost %llu  "
-      "perception %llu skipped %llu (%.1f%%)  stage means: odometry %.1f ms perception %.1f ms\n",
+      "perception %llu skipped %llu (%.1f%%)  stage means: odometry %.1f ms perception %.1f ms  "
+      "cues %llu (sounded %llu) capture->sound p50 %.1f ms p99 %.1f ms\n",
       name, static_cast<unsigned long long>(s.frames_captured), s.fps, s.latency_p50_ms, s.latency_p99_ms,
       static_cast<unsigned long long>(s.odometry_frames),
       static_cast<unsigned long long>(s.odometry_frames_lost + (s.frames_captured - s.odometry_frames)),
       static_cast<unsigned long long>(s.perception_frames),
       static_cast<unsigned long long>(s.perception_skipped), 100.0 * s.perception_drop_rate,
-      s.odometry_ms_mean, s.perception_ms_mean);
+      s.odometry_ms_mean, s.perception_ms_mean, static_cast<unsigned long long>(s.cues),
+      static_cast<unsigned long long>(s.cues_sounded), s.cue_latency_p50_ms, s.cue_latency_p99_ms);
+}
+
+/// The feedback stage alone at 30 Hz, a step tick every third frame: decision -> first sample.
+runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int frames) {
+  PipelineConfig c = config;
+  c.feedback.count_interval = 100;  // ticks only (no spoken counts)
+  c.feedback.min_tick_interval = 0.f;
+  runtime::FeedbackStage stage(c);
+  // "ready" and "first step" come on the first frame (the second waits for the first to end):
+  // the steps that follow are measured on an idle sink.
+  const int warmup = 30;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < warmup + frames; ++i) {
+    if (i == warmup) {
+      stage.drain(std::chrono::milliseconds(3000));
+      stage.clear_cue_latency();
+    }
+    std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i + std::chrono::seconds(i >= warmup ? 1 : 0));
+    runtime::PerceptionOutput p;
+    p.seq = static_cast<std::uint64_t>(i);
+    p.ran = true;
+    p.floor_found = true;
+    p.state = "ascending";
+    p.traversal.ran = true;
+    p.traversal.state = TraversalState::kOnStairs;
+    p.traversal.kind = StairKind::kAscending;
+    p.traversal.direction = 1;
+    p.traversal.steps_climbed = p.traversal.step_index = i < warmup ? 1 : 1 + (i - warmup) / 3;
+    stage.decide(p, nullptr, i / 30.0, std::chrono::steady_clock::now());
+  }
+  stage.drain(std::chrono::milliseconds(3000));
+  return stage.cue_latency();
 }
 
 int bench_daemon(Context& ctx) {
@@ -112,6 +156,7 @@ int bench_daemon(Context& ctx) {
   const bool skip_realtime = ctx.flag("--no-realtime");
   const long frames_wanted = ctx.int_option("--frames", 1, 100000).value_or(600);
   const long reference_frames = ctx.int_option("--reference-frames", 0, 100000).value_or(150);
+  const std::string audio_device = ctx.option("--audio").value_or("null");
   const auto pos = ctx.positionals(0, 1);
   std::string input =
       pos.empty() ? "synth:ascending_approach_climb:" + std::to_string(frames_wanted) + ":1" : pos[0];
@@ -120,6 +165,12 @@ int bench_daemon(Context& ctx) {
   cv::setNumThreads(1);             // as stairguided does at start (see stairguided_main.cpp)
   PipelineConfig config = ctx.config;
   config.runtime.log_level = "warn";
+  // Cues to a sound device that takes samples at the pace of a card (the sink holds itself to
+  // it), no buzzer; the sounds from the source tree when they are not installed.
+  config.feedback.audio_device = audio_device;
+  config.feedback.haptic_enabled = false;
+  if (!std::filesystem::exists(config.feedback.sounds_dir))
+    config.feedback.sounds_dir = std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds";
 
   auto src = open_frame_source(input, config.capture);
   const std::string desc = src->describe();
@@ -151,6 +202,8 @@ int bench_daemon(Context& ctx) {
     if (!json) std::fprintf(stderr, "bench daemon: real-time replay (threaded, %.0f s)...\n", n / 30.0);
     rt = run_once(config, shared, k, desc, n, true, false);
   }
+  if (!json) std::fprintf(stderr, "bench daemon: the cue path (feedback stage at 30 Hz, 10 s)...\n");
+  const auto cues = cue_path(config, 300);
   const Run& lat = skip_realtime ? fast : rt;
   const auto lost = [](const Run& r) {
     return r.stats.odometry_frames_lost + (r.stats.frames_captured - r.stats.odometry_frames);
@@ -162,32 +215,40 @@ int bench_daemon(Context& ctx) {
     std::printf(
         "{\"input\": \"%s\", \"frames\": %ld, \"width\": %d, \"height\": %d, \"fps\": %.2f, "
         "\"latency_p50_ms\": %.2f, \"latency_p99_ms\": %.2f, \"odometry_frames_lost\": %llu, "
-        "\"perception_drop_rate\": %.4f, \"fps_ratio_vs_reference\": %.3f,\n \"fast\": %s,\n \"realtime\": "
-        "%s,\n"
-        " \"reference\": %s}\n",
+        "\"perception_drop_rate\": %.4f, \"fps_ratio_vs_reference\": %.3f, \"cue_latency_p50_ms\": %.2f, "
+        "\"cue_latency_p99_ms\": %.2f,\n \"fast\": %s,\n \"realtime\": %s,\n"
+        " \"reference\": %s,\n \"cue_path\": {\"cues\": %llu, \"sounded\": %llu, \"p50_ms\": %.2f, "
+        "\"p99_ms\": %.2f, \"max_ms\": %.2f}}\n",
         desc.c_str(), n, k.width, k.height, fast.stats.fps, lat.stats.latency_p50_ms,
-        lat.stats.latency_p99_ms, total_lost, lat.stats.perception_drop_rate, ratio, run_json(fast).c_str(),
-        skip_realtime ? "null" : run_json(rt).c_str(),
-        reference_frames > 0 ? run_json(reference).c_str() : "null");
+        lat.stats.latency_p99_ms, total_lost, lat.stats.perception_drop_rate, ratio, lat.stats.cue_latency_p50_ms,
+        lat.stats.cue_latency_p99_ms, run_json(fast).c_str(), skip_realtime ? "null" : run_json(rt).c_str(),
+        reference_frames > 0 ? run_json(reference).c_str() : "null", static_cast<unsigned long long>(cues.cues),
+        static_cast<unsigned long long>(cues.sounded), cues.p50_ms, cues.p99_ms, cues.max_ms);
   } else {
     std::printf("stairguide bench daemon: %s, %ld frames %dx%d\n", desc.c_str(), n, k.width, k.height);
     if (reference_frames > 0) print_run("reference (1 thread)", reference);
     print_run("fast replay", fast);
     if (!skip_realtime) print_run("real-time 30 Hz", rt);
     std::printf("threaded fast replay vs one thread: %.2fx frames per second\n", ratio);
+    std::printf("cue path at 30 Hz: %llu cues, %llu sounded, decision -> first sample p50 %.2f ms p99 %.2f ms max %.2f ms\n",
+                static_cast<unsigned long long>(cues.cues), static_cast<unsigned long long>(cues.sounded),
+                cues.p50_ms, cues.p99_ms, cues.max_ms);
     std::printf(
         "targets: fast >= 60 fps: %s (%.1f); every frame through odometry: %s (%llu lost); "
-        "real-time p99 <= 50 ms: %s (%.1f); perception drops <= 1%%: %s (%.2f%%)\n",
+        "real-time p99 <= 50 ms: %s (%.1f); perception drops <= 1%%: %s (%.2f%%); "
+        "cue capture->sound p99 <= 100 ms: %s (%.1f over %llu cues; the cue path's decision->sound p99 %.1f)\n",
         fast.stats.fps >= 60 ? "PASS" : "FAIL", fast.stats.fps, total_lost == 0 ? "PASS" : "FAIL", total_lost,
         lat.stats.latency_p99_ms <= 50 ? "PASS" : "FAIL", lat.stats.latency_p99_ms,
-        lat.stats.perception_drop_rate <= 0.01 ? "PASS" : "FAIL", 100.0 * lat.stats.perception_drop_rate);
+        lat.stats.perception_drop_rate <= 0.01 ? "PASS" : "FAIL", 100.0 * lat.stats.perception_drop_rate,
+        lat.stats.cues_sounded > 0 && lat.stats.cue_latency_p99_ms <= 100 ? "PASS" : "FAIL",
+        lat.stats.cue_latency_p99_ms, static_cast<unsigned long long>(lat.stats.cues_sounded), cues.p99_ms);
   }
   return 0;
 }
 
 }  // namespace
 
-SG_BENCH("daemon", "daemon [--json] [--frames N] [--reference-frames N] [--no-realtime] [INPUT]",
+SG_BENCH("daemon", "daemon [--json] [--frames N] [--reference-frames N] [--no-realtime] [--audio DEV] [INPUT]",
          "the daemon's threads: fast and 30 Hz replay (fps, latency p50/p99, drops) vs one thread",
          bench_daemon);
 

@@ -9,9 +9,11 @@
 
 namespace stairguide::cli {
 
-/// The q-quantile (0..1) of v, nearest rank; 0 for an empty vector.
-inline double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
+/// The q-quantile (0..1) of v, nearest rank; 0 for an empty vector. (Takes a reference and copies
+/// by iterators: GCC 12's -Wfree-nonheap-object misfires at -O3 on the by-value copy.)
+inline double percentile(const std::vector<double>& values, double q) {
+  if (values.empty()) return 0.0;
+  std::vector<double> v(values.begin(), values.end());
   std::sort(v.begin(), v.end());
   const std::size_t i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
   return v[std::min(i, v.size() - 1)];

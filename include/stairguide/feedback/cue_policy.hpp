@@ -1,0 +1,111 @@
+#pragma once
+/// \file cue_policy.hpp
+/// The cue policy (pure: no threads, no I/O, no clock of its own): one frame's typed perception
+/// and traversal output plus its time in, the cues to give the user out.
+///
+/// - Silence when all is well: a cue is given on a change the user must know of, never per frame.
+/// - Hysteresis: a detection is announced once it has been seen on `confirm_frames` frames over
+///   at least `confirm_time` s with no gap longer than `confirm_time`; an announced staircase is
+///   kept (never retracted by a frame's dropout) until unseen for `forget_time` s, and the same one
+///   is not announced again within `repeat_time` s.
+/// - Rate limits: one cue of a kind per `min_cue_interval` s; ticks at most one per
+///   `min_tick_interval` s.
+/// - A descending staircase within `danger_distance` m (or of unknown distance) always warns,
+///   whatever the verbosity: once while it is held, again when it comes back after being forgotten
+///   (even within `repeat_time`).
+/// - Blind: no floor and nothing seen nor tracked for `blind_after` s: told once, then every
+///   `blind_repeat` s while it lasts.
+/// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
+///   steps left, last step, end) follow its states; without it only the detection cues are given.
+///
+/// Verbosity: quiet = warnings (drop, last step, blind, camera) and earcons for stairs and steps
+/// ahead; normal = the words for what is ahead, first step, ticks, counts every `count_interval`
+/// steps, steps left once known, end of stairs; verbose = also the distance as it shrinks and
+/// the clock position straight ahead (12), steps left with every count.
+
+#include <vector>
+
+#include "stairguide/core/config.hpp"
+#include "stairguide/feedback/cue.hpp"
+#include "stairguide/stairs/traversal_result.hpp"
+
+namespace stairguide::feedback {
+
+enum class Verbosity { kQuiet, kNormal, kVerbose };
+/// "quiet", "normal", "verbose" (the loader has validated it); anything else is kNormal.
+Verbosity parse_verbosity(const std::string& s);
+
+/// What the policy reads of one perceived frame.
+struct CueInput {
+  double t = 0.0;             ///< s, the frame's timestamp (monotonic within a run)
+  bool floor_found = false;   ///< the floor is seen in this frame
+  StairSummary stair;         ///< this frame's detection
+  TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
+};
+
+/// Clock position (1..12, 12 straight ahead, 3 to the right) of a bearing in rad; 12 for NaN.
+int clock_position(float bearing_rad);
+
+class CuePolicy {
+ public:
+  explicit CuePolicy(const FeedbackConfig& config);
+  /// New tunables (verbosity...) from the next frame on; what was told is kept.
+  void reconfigure(const FeedbackConfig& config);
+
+  /// The cues for one frame, highest priority first (empty when nothing is to be said).
+  std::vector<CueEvent> step(const CueInput& in);
+  /// The camera stopped sending / is back (`t`: time of the last frame seen, s).
+  std::vector<CueEvent> camera_lost(double t);
+  std::vector<CueEvent> camera_back(double t);
+
+ private:
+  struct Sighting {
+    bool present = false;
+    StairKind kind = StairKind::kNone;
+    int direction = 0;
+    float distance_m = 0.f;  // NaN: unknown
+    float bearing_rad = 0.f;
+  };
+  struct Candidate {
+    bool active = false;
+    int key = 0;
+    int frames = 0;
+    double first_t = 0.0, last_t = 0.0;
+  };
+  struct Told {
+    bool active = false;     // a staircase (or step) is confirmed and held
+    bool announced = false;  // ... and the user has been told of it
+    bool warned = false;     // ... the drop warning has been given
+    int key = 0;
+    double last_seen_t = 0.0, told_t = -1e9;
+    int last_metres = -1;
+  };
+
+  static int key_of(StairKind kind, int direction);
+  bool allowed(Cue c) const;
+  bool rate_ok(Cue c, double t) const;
+  void emit(std::vector<CueEvent>& out, CueEvent e, double t);
+  CueEvent ahead_event(const Sighting& s, bool drop) const;
+  void detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out);
+  void flight_cues(const TraversalResult& tr, double t, std::vector<CueEvent>& out);
+  void blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out);
+
+  FeedbackConfig cfg_;
+  Verbosity verbosity_ = Verbosity::kNormal;
+  bool ready_told_ = false;
+  bool camera_down_ = false;
+  Candidate cand_;
+  Told told_;
+  // Flight (traversal tracker) state.
+  TraversalState prev_state_ = TraversalState::kSearching;
+  int prev_climbed_ = 0;
+  bool steps_left_told_ = false;
+  double last_tick_t_ = -1e9;
+  // Blind.
+  double blind_since_ = -1.0;
+  double last_blind_t_ = -1e9;
+  double last_frame_t_ = -1e9;
+  double last_t_[16] = {};  // per Cue, the last time it was given
+};
+
+}  // namespace stairguide::feedback

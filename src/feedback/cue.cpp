@@ -1,0 +1,176 @@
+#include "stairguide/feedback/cue.hpp"
+
+namespace stairguide::feedback {
+
+namespace {
+constexpr int kMaxNumber = 30;  // numbers n1..n30 are recorded
+std::string number_clip(int n) { return "n" + std::to_string(n); }
+bool sayable(int n) { return n >= 1 && n <= kMaxNumber; }
+}  // namespace
+
+const char* to_string(Cue c) {
+  switch (c) {
+    case Cue::kReady:
+      return "ready";
+    case Cue::kCameraLost:
+      return "camera_lost";
+    case Cue::kCameraBack:
+      return "camera_back";
+    case Cue::kBlind:
+      return "blind";
+    case Cue::kStairsAhead:
+      return "stairs_ahead";
+    case Cue::kDropWarning:
+      return "drop_warning";
+    case Cue::kStepAhead:
+      return "step_ahead";
+    case Cue::kFirstStep:
+      return "first_step";
+    case Cue::kTick:
+      return "tick";
+    case Cue::kCount:
+      return "count";
+    case Cue::kStepsLeft:
+      return "steps_left";
+    case Cue::kLastStep:
+      return "last_step";
+    case Cue::kEndOfStairs:
+      return "end_of_stairs";
+  }
+  return "?";
+}
+
+int cue_priority(Cue c) {
+  // Step feedback is the lowest (a newer step makes an old tick stale); what is ahead comes next;
+  // the system's own blindness and the last step are warnings; a drop ahead is the highest.
+  switch (c) {
+    case Cue::kTick:
+      return 1;
+    case Cue::kCount:
+      return 2;
+    case Cue::kReady:
+      return 3;
+    case Cue::kStairsAhead:
+    case Cue::kStepAhead:
+    case Cue::kFirstStep:
+    case Cue::kStepsLeft:
+    case Cue::kEndOfStairs:
+    case Cue::kCameraBack:
+      return 4;
+    case Cue::kLastStep:
+    case Cue::kBlind:
+      return 6;
+    case Cue::kCameraLost:
+      return 7;
+    case Cue::kDropWarning:
+      return 8;
+  }
+  return 0;
+}
+
+std::string token(const CueEvent& e) {
+  std::string s = to_string(e.cue);
+  if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning) {
+    if (e.cue == Cue::kStepAhead) s = e.kind == StairKind::kCurb ? "curb" : "step";
+    s += e.direction > 0 ? "_up" : "_down";
+    if (e.number >= 0) s += ":" + std::to_string(e.number) + "m";
+    if (e.clock > 0) s += "@" + std::to_string(e.clock);
+  } else if (e.number >= 0) {
+    s += ":" + std::to_string(e.number);
+  }
+  return s;
+}
+
+std::string tokens(const std::vector<CueEvent>& events) {
+  std::string s;
+  for (const auto& e : events) {
+    if (!s.empty()) s += '+';
+    s += token(e);
+  }
+  return s;
+}
+
+std::vector<std::string> clips_for(const CueEvent& e) {
+  std::vector<std::string> c;
+  const bool up = e.direction > 0;
+  auto distance = [&] {
+    if (sayable(e.number)) {
+      c.push_back(number_clip(e.number));
+      c.push_back(e.number == 1 ? "metre" : "metres");
+    }
+    if (e.clock >= 1 && e.clock <= 12) {
+      c.push_back(number_clip(e.clock));
+      c.push_back("oclock");
+    }
+  };
+  switch (e.cue) {
+    case Cue::kReady:
+      c = {"ready"};
+      break;
+    case Cue::kCameraLost:
+      c = {"camera_lost"};
+      break;
+    case Cue::kCameraBack:
+      c = {"camera_back"};
+      break;
+    case Cue::kBlind:
+      c = {"cannot_see"};
+      break;
+    case Cue::kStairsAhead:
+      if (e.earcon_only) {
+        c = {up ? "up" : "down"};
+      } else {
+        c = {up ? "stairs_up" : "stairs_down"};
+        distance();
+      }
+      break;
+    case Cue::kDropWarning:
+      c = {"warning", "stairs_down"};
+      distance();
+      break;
+    case Cue::kStepAhead:
+      if (e.earcon_only)
+        c = {up ? "up" : "down"};
+      else if (e.kind == StairKind::kCurb)
+        c = {up ? "curb_up" : "curb_down"};
+      else
+        c = {up ? "step_up" : "step_down"};
+      break;
+    case Cue::kFirstStep:
+      c = {"first_step"};
+      break;
+    case Cue::kTick:
+      c = {"tick"};
+      break;
+    case Cue::kCount:
+      if (sayable(e.number))
+        c = {number_clip(e.number)};
+      else
+        c = {"tick"};
+      break;
+    case Cue::kStepsLeft:
+      if (sayable(e.number)) c = {number_clip(e.number), "steps_left"};
+      break;
+    case Cue::kLastStep:
+      c = {"last_step"};
+      break;
+    case Cue::kEndOfStairs:
+      c = {"end_of_stairs"};
+      break;
+  }
+  return c;
+}
+
+const std::vector<std::string>& all_clip_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {
+        "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
+        "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
+        "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning"};
+    for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
+    return n;
+  }();
+  return names;
+}
+
+}  // namespace stairguide::feedback

@@ -1,0 +1,271 @@
+#include "stairguide/feedback/cue_policy.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stairguide::feedback {
+
+namespace {
+constexpr double kNever = -1e9;
+bool is_stairs(StairKind k) { return k == StairKind::kAscending || k == StairKind::kDescending; }
+bool on_flight(TraversalState s) { return s == TraversalState::kOnStairs || s == TraversalState::kLastStep; }
+int metres_of(float d) { return std::isfinite(d) ? std::max(1, static_cast<int>(std::lround(d))) : -1; }
+}  // namespace
+
+Verbosity parse_verbosity(const std::string& s) {
+  if (s == "quiet") return Verbosity::kQuiet;
+  if (s == "verbose") return Verbosity::kVerbose;
+  return Verbosity::kNormal;
+}
+
+int clock_position(float bearing_rad) {
+  if (!std::isfinite(bearing_rad)) return 12;
+  const int h = static_cast<int>(std::lround(bearing_rad / (M_PI / 6.0)));
+  const int c = ((h % 12) + 12) % 12;
+  return c == 0 ? 12 : c;
+}
+
+CuePolicy::CuePolicy(const FeedbackConfig& config) {
+  std::fill(std::begin(last_t_), std::end(last_t_), kNever);
+  reconfigure(config);
+}
+
+void CuePolicy::reconfigure(const FeedbackConfig& config) {
+  cfg_ = config;
+  verbosity_ = parse_verbosity(config.verbosity);
+}
+
+int CuePolicy::key_of(StairKind kind, int direction) {
+  if (direction == 0) direction = kind == StairKind::kDescending ? -1 : 1;
+  return (is_stairs(kind) ? 1 : 2) * (direction > 0 ? 1 : -1);
+}
+
+bool CuePolicy::allowed(Cue c) const {
+  if (verbosity_ != Verbosity::kQuiet) return true;
+  switch (c) {
+    case Cue::kReady:
+    case Cue::kCameraLost:
+    case Cue::kCameraBack:
+    case Cue::kBlind:
+    case Cue::kDropWarning:
+    case Cue::kLastStep:
+    case Cue::kStairsAhead:  // as an earcon
+    case Cue::kStepAhead:
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool CuePolicy::rate_ok(Cue c, double t) const {
+  const double last = last_t_[static_cast<int>(c)];
+  switch (c) {
+    case Cue::kDropWarning:  // always warns (told once per staircase by the caller)
+    case Cue::kCameraLost:
+    case Cue::kCameraBack:
+    case Cue::kReady:
+    case Cue::kCount:
+      return true;
+    case Cue::kTick:
+      return t - last >= cfg_.min_tick_interval;
+    case Cue::kBlind:
+      return t - last >= cfg_.blind_repeat;
+    default:
+      return t - last >= cfg_.min_cue_interval;
+  }
+}
+
+void CuePolicy::emit(std::vector<CueEvent>& out, CueEvent e, double t) {
+  e.priority = cue_priority(e.cue);
+  last_t_[static_cast<int>(e.cue)] = t;
+  out.push_back(e);
+}
+
+CueEvent CuePolicy::ahead_event(const Sighting& s, bool drop) const {
+  CueEvent e;
+  const bool stairs = is_stairs(s.kind);
+  e.cue = drop ? Cue::kDropWarning : stairs ? Cue::kStairsAhead : Cue::kStepAhead;
+  e.kind = s.kind;
+  e.direction = key_of(s.kind, s.direction) > 0 ? 1 : -1;
+  if (stairs) {
+    e.number = metres_of(s.distance_m);
+    const int c = clock_position(s.bearing_rad);
+    e.clock = c == 12 && verbosity_ != Verbosity::kVerbose ? 0 : c;
+  }
+  e.earcon_only = verbosity_ == Verbosity::kQuiet && !drop;
+  return e;
+}
+
+void CuePolicy::detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out) {
+  if (told_.active && t - told_.last_seen_t > cfg_.forget_time) told_.active = false;
+  if (cand_.active && t - cand_.last_t > cfg_.confirm_time) cand_.active = false;
+  if (!s.present) return;
+  const int key = key_of(s.kind, s.direction);
+  if (told_.active && key == told_.key) {
+    told_.last_seen_t = t;
+  } else {
+    if (cand_.active && cand_.key == key) {
+      ++cand_.frames;
+      cand_.last_t = t;
+    } else {
+      cand_ = Candidate{true, key, 1, t, t};
+    }
+    if (cand_.frames < cfg_.confirm_frames || t - cand_.first_t < cfg_.confirm_time - 1e-6) return;
+    // Confirmed. The same staircase re-found soon after it was forgotten is not told again.
+    const bool told_recently = key == told_.key && t - told_.told_t < cfg_.repeat_time;
+    if (!told_recently) {
+      told_ = Told{};
+      told_.key = key;
+    }
+    // A drop ahead is warned of again once it has been out of mind (forgotten) and comes back.
+    told_.warned = false;
+    told_.active = true;
+    told_.last_seen_t = t;
+    cand_.active = false;
+  }
+  const int metres = metres_of(s.distance_m);
+  const bool drop = key == -1 && (!std::isfinite(s.distance_m) || s.distance_m <= cfg_.danger_distance);
+  if (drop) {
+    if (!told_.warned) {
+      emit(out, ahead_event(s, true), t);
+      told_.warned = told_.announced = true;
+      told_.told_t = t;
+      told_.last_metres = metres;
+    }
+    return;
+  }
+  const bool near = !std::isfinite(s.distance_m) || s.distance_m <= cfg_.announce_distance;
+  if (!near) return;
+  const CueEvent e = ahead_event(s, false);
+  if (!told_.announced) {
+    if (!allowed(e.cue) || !rate_ok(e.cue, t)) return;
+    emit(out, e, t);
+    told_.announced = true;
+    told_.told_t = t;
+    told_.last_metres = metres;
+  } else if (verbosity_ == Verbosity::kVerbose && e.cue == Cue::kStairsAhead && metres >= 1 &&
+             told_.last_metres > metres && rate_ok(e.cue, t)) {
+    emit(out, e, t);  // the distance as it shrinks, a metre at a time
+    told_.last_metres = metres;
+  }
+}
+
+void CuePolicy::flight_cues(const TraversalResult& tr, double t, std::vector<CueEvent>& out) {
+  const TraversalState st = tr.state;
+  auto give = [&](Cue c, int number, bool rate_limited) {
+    if (!allowed(c) || (rate_limited && !rate_ok(c, t))) return false;
+    CueEvent e;
+    e.cue = c;
+    e.number = number;
+    e.direction = tr.direction;
+    emit(out, e, t);
+    return true;
+  };
+  const bool now_on = on_flight(st), was_on = on_flight(prev_state_);
+  if (now_on && !was_on) {
+    // On the flight: what was told of the approach is done with (and not told again soon).
+    told_.active = false;
+    told_.told_t = t;
+    cand_.active = false;
+    steps_left_told_ = false;
+    prev_climbed_ = tr.steps_climbed;
+    if (st == TraversalState::kLastStep)
+      give(Cue::kLastStep, -1, false);
+    else
+      give(Cue::kFirstStep, -1, true);
+    if (tr.steps_left >= 2 && give(Cue::kStepsLeft, tr.steps_left, false)) steps_left_told_ = true;
+  } else if (now_on) {
+    if (st == TraversalState::kLastStep && prev_state_ != TraversalState::kLastStep) {
+      give(Cue::kLastStep, -1, true);  // a warning: no tick on this frame
+    } else if (tr.steps_climbed > prev_climbed_) {
+      const int n = tr.steps_climbed;
+      if (n % cfg_.count_interval == 0) {
+        if (verbosity_ == Verbosity::kVerbose && tr.steps_left >= 1)
+          give(Cue::kStepsLeft, tr.steps_left, false);
+        else
+          give(Cue::kCount, n, false);
+      } else if (t - last_tick_t_ >= cfg_.min_tick_interval && give(Cue::kTick, -1, false)) {
+        last_tick_t_ = t;
+      }
+    }
+    if (!steps_left_told_ && tr.steps_left >= 2 && give(Cue::kStepsLeft, tr.steps_left, true))
+      steps_left_told_ = true;
+  }
+  if (now_on) prev_climbed_ = std::max(prev_climbed_, tr.steps_climbed);
+  if (st == TraversalState::kArrived && prev_state_ != TraversalState::kArrived)
+    give(Cue::kEndOfStairs, -1, true);
+  prev_state_ = st;
+}
+
+void CuePolicy::blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out) {
+  const bool tracking = in.traversal.ran && in.traversal.state != TraversalState::kSearching;
+  if (in.floor_found || in.stair.detected || tracking) {
+    blind_since_ = -1.0;
+    return;
+  }
+  if (blind_since_ < 0) blind_since_ = t;
+  if (t - blind_since_ >= cfg_.blind_after && t - last_blind_t_ >= cfg_.blind_repeat) {
+    CueEvent e;
+    e.cue = Cue::kBlind;
+    emit(out, e, t);
+    last_blind_t_ = t;
+  }
+}
+
+std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
+  std::vector<CueEvent> out;
+  const double t = in.t;
+  if (t + 1.0 < last_frame_t_) {
+    // The clock went back (a reopened camera restarts its timestamps): start afresh.
+    cand_ = Candidate{};
+    told_ = Told{};
+    std::fill(std::begin(last_t_), std::end(last_t_), kNever);
+    last_tick_t_ = last_blind_t_ = kNever;
+    blind_since_ = -1.0;
+  }
+  last_frame_t_ = t;
+  if (!ready_told_) {
+    ready_told_ = true;
+    CueEvent e;
+    e.cue = Cue::kReady;
+    emit(out, e, t);
+  }
+  const TraversalResult& tr = in.traversal;
+  Sighting s;
+  if (tr.ran && tr.state == TraversalState::kStairAhead && tr.kind != StairKind::kNone) {
+    s = Sighting{true, tr.kind, tr.direction, tr.distance_m, tr.bearing_rad};
+  } else if (in.stair.detected &&
+             !(tr.ran && (on_flight(tr.state) || tr.state == TraversalState::kArrived))) {
+    s = Sighting{true, in.stair.kind, in.stair.direction, in.stair.distance_m, in.stair.bearing_rad};
+  }
+  if (s.present && s.kind == StairKind::kNone) s.present = false;
+  detection_cues(s, t, out);
+  if (tr.ran) flight_cues(tr, t, out);
+  blind_cues(in, t, out);
+  std::stable_sort(out.begin(), out.end(),
+                   [](const CueEvent& a, const CueEvent& b) { return a.priority > b.priority; });
+  return out;
+}
+
+std::vector<CueEvent> CuePolicy::camera_lost(double t) {
+  std::vector<CueEvent> out;
+  if (camera_down_) return out;
+  camera_down_ = true;
+  blind_since_ = -1.0;
+  CueEvent e;
+  e.cue = Cue::kCameraLost;
+  emit(out, e, t);
+  return out;
+}
+
+std::vector<CueEvent> CuePolicy::camera_back(double t) {
+  std::vector<CueEvent> out;
+  if (!camera_down_) return out;
+  camera_down_ = false;
+  CueEvent e;
+  e.cue = Cue::kCameraBack;
+  emit(out, e, t);
+  return out;
+}
+
+}  // namespace stairguide::feedback

@@ -1,0 +1,207 @@
+// The feedback stage: the cue policy (feedback room, pure) on every perceived frame, its cues
+// played through the sound sink and the buzzer. The sinks are opened on first use (so that a
+// stage made only to describe itself opens nothing); each keeps its own thread, so decide()
+// never waits on a device. A sink that cannot be had is logged and the other goes on.
+#include <spdlog/spdlog.h>
+
+#include <mutex>
+#include <unordered_map>
+
+#include "stairguide/feedback/audio_sink.hpp"
+#include "stairguide/feedback/cue_policy.hpp"
+#include "stairguide/feedback/haptic.hpp"
+#include "stairguide/runtime/latency.hpp"
+#include "stairguide/runtime/pipeline.hpp"
+
+namespace stairguide::runtime {
+
+namespace fb = stairguide::feedback;
+using SteadyClock = std::chrono::steady_clock;
+
+struct FeedbackStage::Impl {
+  PipelineConfig config;
+  fb::CuePolicy policy;
+  // Cue latency: written by decide() and by the sound thread's on_start
+  // (declared before the sinks: their threads are joined first).
+  mutable std::mutex lat_mutex;
+  std::unordered_map<std::uint64_t, SteadyClock::time_point> pending;  // utterance id -> capture
+  LatencyHistogram latency;
+  std::uint64_t cues = 0;
+  std::string last_cue;
+
+  std::unique_ptr<fb::AudioSink> audio;
+  std::unique_ptr<fb::Haptic> haptic;
+  bool sinks_open = false;
+  std::string last_state = "none";
+  double last_t = 0.0;
+  std::uint64_t next_id = 1;
+
+  explicit Impl(const PipelineConfig& c) : config(c), policy(c.feedback) {}
+
+  void open_sinks() {
+    if (sinks_open) return;
+    sinks_open = true;
+    const FeedbackConfig& f = config.feedback;
+    fb::SoundBank bank;
+    if (f.audio_enabled) {
+      bank = fb::load_sound_bank(f.sounds_dir, fb::all_clip_names(), f.volume);
+      if (bank.clips.empty())
+        spdlog::error(
+            "audio: no usable sound in '{}' (feedback.sounds_dir; {}): cues are silent, the buzzer "
+            "goes on",
+            f.sounds_dir, bank.problems.empty() ? std::string("empty") : bank.problems.front());
+      else
+        for (const auto& p : bank.problems) spdlog::error("audio: sound {}: that cue is silent", p);
+    }
+    if (f.audio_enabled && !bank.clips.empty()) {
+      fb::AlsaSinkOptions o;
+      o.device = f.audio_device;
+      o.retry_s = f.audio_retry;
+      fb::AudioEvents ev;
+      ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
+      ev.info = [](const std::string& s) { spdlog::info("{}", s); };
+      ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) {
+        std::lock_guard<std::mutex> lk(lat_mutex);
+        const auto it = pending.find(id);
+        if (it == pending.end()) return;
+        latency.add(std::chrono::duration<double, std::milli>(t - it->second).count());
+        pending.erase(it);
+      };
+      audio = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
+    } else {
+      audio = std::make_unique<fb::NullAudioSink>();
+    }
+    haptic = std::make_unique<fb::NullHaptic>();
+    if (f.haptic_enabled) {
+      try {
+        haptic = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
+        spdlog::info("haptic: buzzer on {}", haptic->describe());
+      } catch (const std::exception& e) {
+        spdlog::error("{}; going on with audio only (feedback.haptic_enabled: false silences this)",
+                      e.what());
+      }
+    }
+  }
+
+  std::string deliver(const std::vector<fb::CueEvent>& cues_now, SteadyClock::time_point captured) {
+    if (cues_now.empty()) return "";
+    open_sinks();
+    bool buzzed = false;
+    for (const auto& e : cues_now) {
+      fb::Utterance u;
+      u.id = next_id++;
+      u.priority = e.priority;
+      u.clips = fb::clips_for(e);
+      u.label = fb::token(e);
+      {
+        std::lock_guard<std::mutex> lk(lat_mutex);
+        if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
+        pending[u.id] = captured;
+        ++cues;
+        last_cue = u.label;
+      }
+      audio->play(std::move(u));
+      // One pattern per frame, the most urgent (the cues come highest priority first).
+      if (!buzzed) {
+        const fb::HapticPattern p = fb::haptic_pattern(e);
+        if (!p.empty()) {
+          haptic->play(p, e.priority);
+          buzzed = true;
+        }
+      }
+    }
+    return fb::tokens(cues_now);
+  }
+};
+
+FeedbackStage::FeedbackStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+FeedbackStage::~FeedbackStage() = default;
+
+Decision FeedbackStage::decide(const PerceptionOutput& perception, const OdometryOutput* /*latest_odometry*/,
+                               double timestamp_s, SteadyClock::time_point captured) {
+  Decision d;
+  d.state = perception.state;
+  d.changed = d.state != impl_->last_state;
+  impl_->last_state = d.state;
+  impl_->last_t = timestamp_s;
+  if (!perception.ran) return d;  // no perception stage: nothing to tell
+  fb::CueInput in;
+  in.t = timestamp_s;
+  in.floor_found = perception.floor_found;
+  in.stair = perception.stair;
+  in.traversal = perception.traversal;
+  d.cue = impl_->deliver(impl_->policy.step(in), captured);
+  return d;
+}
+
+void FeedbackStage::camera_lost(const std::string& why) {
+  const auto c = impl_->deliver(impl_->policy.camera_lost(impl_->last_t), SteadyClock::now());
+  if (!c.empty()) spdlog::info("cue {} ({})", c, why);
+}
+void FeedbackStage::camera_back() {
+  const auto c = impl_->deliver(impl_->policy.camera_back(impl_->last_t), SteadyClock::now());
+  if (!c.empty()) spdlog::info("cue {}", c);
+}
+
+void FeedbackStage::reconfigure(const PipelineConfig& config) {
+  const FeedbackConfig& a = impl_->config.feedback;
+  const FeedbackConfig& b = config.feedback;
+  if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
+  if (impl_->sinks_open &&
+      (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
+       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
+       a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line))
+    spdlog::info("feedback: sound device, sounds and buzzer settings apply at the next start");
+  PipelineConfig keep = config;
+  const FeedbackConfig old = impl_->config.feedback;
+  keep.feedback = b;
+  if (impl_->sinks_open) {
+    // The sinks stay as opened; only the policy's tunables change now.
+    keep.feedback.audio_enabled = old.audio_enabled;
+    keep.feedback.audio_device = old.audio_device;
+    keep.feedback.sounds_dir = old.sounds_dir;
+    keep.feedback.volume = old.volume;
+    keep.feedback.haptic_enabled = old.haptic_enabled;
+    keep.feedback.gpio_chip = old.gpio_chip;
+    keep.feedback.gpio_line = old.gpio_line;
+  }
+  impl_->config = keep;
+  impl_->policy.reconfigure(keep.feedback);
+}
+
+bool FeedbackStage::available() const { return true; }
+
+std::string FeedbackStage::describe() const {
+  const FeedbackConfig& f = impl_->config.feedback;
+  return "CuePolicy(" + f.verbosity + ")+audio=" + (f.audio_enabled ? "alsa:" + f.audio_device : "off") +
+         "+haptic=" + (f.haptic_enabled ? f.gpio_chip + ":" + std::to_string(f.gpio_line) : "off");
+}
+
+void FeedbackStage::drain(std::chrono::milliseconds timeout) {
+  if (!impl_->sinks_open) return;
+  const auto until = SteadyClock::now() + timeout;
+  impl_->audio->drain(timeout);
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - SteadyClock::now());
+  impl_->haptic->drain(std::max(left, std::chrono::milliseconds(0)));
+}
+
+FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
+  std::lock_guard<std::mutex> lk(impl_->lat_mutex);
+  CueLatency c;
+  c.cues = impl_->cues;
+  c.sounded = impl_->latency.count();
+  c.p50_ms = impl_->latency.percentile(50);
+  c.p99_ms = impl_->latency.percentile(99);
+  c.max_ms = impl_->latency.max();
+  c.last = impl_->last_cue;
+  return c;
+}
+
+void FeedbackStage::clear_cue_latency() {
+  std::lock_guard<std::mutex> lk(impl_->lat_mutex);
+  impl_->latency.clear();
+  impl_->pending.clear();
+  impl_->cues = 0;
+}
+
+}  // namespace stairguide::runtime

@@ -1,0 +1,99 @@
+#pragma once
+// Helpers of the feedback tests: an ALSA configuration whose PCMs write what is played to raw
+// files (`type file` over `type null`), and finding the cues in the captured samples by normalised
+// cross-correlation with the WAVs.
+#include <stdlib.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "stairguide/feedback/sound_bank.hpp"
+
+namespace sgtest {
+
+namespace fs = std::filesystem;
+
+inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
+
+/// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 mono raw).
+inline void write_alsa_config(const fs::path& conf, const fs::path& dir,
+                              const std::vector<std::string>& names) {
+  fs::create_directories(dir);
+  std::ofstream f(conf);
+  for (const auto& n : names)
+    f << "pcm." << n << " {\n  type file\n  slave.pcm { type null }\n  file \""
+      << (dir / (n + ".raw")).string() << "\"\n  format \"raw\"\n}\n";
+}
+
+inline std::vector<std::int16_t> read_raw(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  const std::vector<char> b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::vector<std::int16_t> s(b.size() / 2);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s[i] = static_cast<std::int16_t>(static_cast<unsigned char>(b[2 * i]) |
+                                     (static_cast<unsigned char>(b[2 * i + 1]) << 8));
+  return s;
+}
+
+inline std::vector<std::int16_t> clip(const std::string& name) {
+  std::vector<std::int16_t> s;
+  int rate = 0;
+  std::string why;
+  stairguide::feedback::read_wav(sounds_dir() + "/" + name + ".wav", s, rate, why);
+  return s;
+}
+
+struct Hit {
+  std::string name;
+  long pos = -1;  ///< sample index in the capture
+  double score = 0.0;
+};
+
+/// Every place `name`'s WAV occurs in `cap` with a normalised correlation above `min_score`
+/// (peaks at least a clip's length apart).
+inline std::vector<Hit> find_all(const std::vector<std::int16_t>& cap, const std::string& name,
+                                 double min_score = 0.97) {
+  const std::vector<std::int16_t> c = clip(name);
+  std::vector<Hit> hits;
+  if (c.empty() || cap.size() < c.size()) return hits;
+  cv::Mat a(1, static_cast<int>(cap.size()), CV_32F), t(1, static_cast<int>(c.size()), CV_32F), r;
+  for (std::size_t i = 0; i < cap.size(); ++i) a.at<float>(0, static_cast<int>(i)) = cap[i];
+  for (std::size_t i = 0; i < c.size(); ++i) t.at<float>(0, static_cast<int>(i)) = c[i];
+  cv::matchTemplate(a, t, r, cv::TM_CCOEFF_NORMED);
+  const int n = r.cols, len = static_cast<int>(c.size());
+  for (int i = 0; i < n; ++i) {
+    const float v = r.at<float>(0, i);
+    if (!(v >= min_score)) continue;
+    // the peak of this run
+    int best = i;
+    for (int j = i; j < std::min(n, i + len); ++j)
+      if (r.at<float>(0, j) > r.at<float>(0, best)) best = j;
+    hits.push_back({name, best, r.at<float>(0, best)});
+    i = best + len - 1;
+  }
+  return hits;
+}
+
+/// The clips among `names` heard in `cap`, in the order heard.
+inline std::vector<Hit> heard(const std::vector<std::int16_t>& cap, const std::vector<std::string>& names,
+                              double min_score = 0.97) {
+  std::vector<Hit> all;
+  for (const auto& n : names)
+    for (const auto& h : find_all(cap, n, min_score)) all.push_back(h);
+  std::sort(all.begin(), all.end(), [](const Hit& a, const Hit& b) { return a.pos < b.pos; });
+  return all;
+}
+
+inline std::vector<std::string> names_of(const std::vector<Hit>& h) {
+  std::vector<std::string> n;
+  for (const auto& x : h) n.push_back(x.name);
+  return n;
+}
+
+}  // namespace sgtest

@@ -1,0 +1,472 @@
+// The cue policy on scripted frame sequences: what is said, in which order, and what is not
+// (hysteresis, rate limits, priorities, verbosity, the blind cue, stair-free sequences). The flight
+// cues (first step, ticks, counts, steps left, last step, end) are driven by scripted
+// TraversalResult sequences: the traversal tracker is another room's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "stairguide/feedback/cue_policy.hpp"
+#include "stairguide/feedback/haptic.hpp"
+
+using namespace stairguide;
+using namespace stairguide::feedback;
+
+namespace {
+
+constexpr double kDt = 1.0 / 30.0;
+
+struct Said {
+  double t;
+  CueEvent e;
+};
+
+CueInput floor_frame(double t) {
+  CueInput in;
+  in.t = t;
+  in.floor_found = true;
+  return in;
+}
+
+CueInput stair_frame(double t, StairKind kind, float distance, float bearing = 0.f) {
+  CueInput in = floor_frame(t);
+  in.stair.detected = true;
+  in.stair.kind = kind;
+  in.stair.direction = kind == StairKind::kDescending ? -1 : 1;
+  in.stair.distance_m = distance;
+  in.stair.bearing_rad = bearing;
+  return in;
+}
+
+std::vector<Said> feed(CuePolicy& p, const std::vector<CueInput>& frames) {
+  std::vector<Said> out;
+  for (const auto& f : frames)
+    for (const auto& e : p.step(f)) out.push_back({f.t, e});
+  return out;
+}
+
+std::vector<std::string> toks(const std::vector<Said>& s) {
+  std::vector<std::string> t;
+  for (const auto& x : s) t.push_back(token(x.e));
+  return t;
+}
+
+bool about_stairs(const CueEvent& e) {
+  return e.cue == Cue::kStairsAhead || e.cue == Cue::kDropWarning || e.cue == Cue::kStepAhead ||
+         e.cue == Cue::kFirstStep || e.cue == Cue::kTick || e.cue == Cue::kCount ||
+         e.cue == Cue::kStepsLeft || e.cue == Cue::kLastStep || e.cue == Cue::kEndOfStairs;
+}
+
+int count_of(const std::vector<Said>& s, Cue c) {
+  int n = 0;
+  for (const auto& x : s) n += x.e.cue == c;
+  return n;
+}
+
+/// Walking toward a staircase at 1 m/s from `from` metres, one frame per kDt, for `seconds`.
+std::vector<CueInput> approach(double t0, StairKind kind, float from, double seconds, float bearing = 0.f) {
+  std::vector<CueInput> f;
+  for (double t = 0; t < seconds; t += kDt)
+    f.push_back(stair_frame(t0 + t, kind, std::max(0.3f, from - static_cast<float>(t)), bearing));
+  return f;
+}
+
+}  // namespace
+
+TEST(FeedbackPolicy, FloorOnlyIsSilentAfterReady) {
+  CuePolicy p{FeedbackConfig{}};
+  std::vector<CueInput> frames;
+  for (int i = 0; i < 900; ++i) frames.push_back(floor_frame(i * kDt));  // 30 s
+  const auto s = feed(p, frames);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].e.cue, Cue::kReady);
+  EXPECT_DOUBLE_EQ(s[0].t, 0.0);
+}
+
+TEST(FeedbackPolicy, AscendingAnnouncedOnceAfterConfirmation) {
+  FeedbackConfig c;  // confirm 4 frames over 0.3 s
+  CuePolicy p{c};
+  auto frames = approach(0.0, StairKind::kAscending, 3.2f, 3.0);
+  const auto s = feed(p, frames);
+  ASSERT_EQ(s.size(), 2u) << ::testing::PrintToString(toks(s));
+  EXPECT_EQ(s[0].e.cue, Cue::kReady);
+  EXPECT_EQ(token(s[1].e), "stairs_ahead_up:3m");  // straight ahead: no clock said
+  // Not before the detection has persisted confirm_time, and on the first frame after it.
+  EXPECT_GE(s[1].t, c.confirm_time - 1e-6);  // (confirm_time is a float)
+  EXPECT_LT(s[1].t, c.confirm_time + kDt + 1e-9);
+  EXPECT_EQ(clips_for(s[1].e), (std::vector<std::string>{"stairs_up", "n3", "metres"}));
+}
+
+TEST(FeedbackPolicy, ClockPositionAndSideAreSaid) {
+  EXPECT_EQ(clock_position(0.f), 12);
+  EXPECT_EQ(clock_position(static_cast<float>(M_PI / 2)), 3);
+  EXPECT_EQ(clock_position(static_cast<float>(-M_PI / 3)), 10);
+  EXPECT_EQ(clock_position(std::nanf("")), 12);
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, approach(0.0, StairKind::kAscending, 2.2f, 1.0, static_cast<float>(M_PI / 6)));
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(token(s[1].e), "stairs_ahead_up:2m@1");
+  EXPECT_EQ(clips_for(s[1].e), (std::vector<std::string>{"stairs_up", "n2", "metres", "n1", "oclock"}));
+}
+
+TEST(FeedbackPolicy, FlickerIsNeverAnnounced) {
+  CuePolicy p{FeedbackConfig{}};
+  std::vector<CueInput> frames;
+  // 60 s of floor with a false detection: 3 frames in a row every second (< confirm_frames), and
+  // single frames every 0.5 s (gaps > confirm_time): never confirmed.
+  for (int i = 0; i < 1800; ++i) {
+    const double t = i * kDt;
+    const int in_second = i % 30;
+    if (in_second < 3 || in_second == 15)
+      frames.push_back(
+          stair_frame(t, in_second == 15 ? StairKind::kDescending : StairKind::kAscending, 2.5f));
+    else
+      frames.push_back(floor_frame(t));
+  }
+  const auto s = feed(p, frames);
+  for (const auto& x : s) EXPECT_FALSE(about_stairs(x.e)) << token(x.e) << " at " << x.t;
+  EXPECT_EQ(s.size(), 1u);
+}
+
+TEST(FeedbackPolicy, DropoutDoesNotRetractNorRepeat) {
+  FeedbackConfig c;  // forget 3 s, repeat 20 s
+  CuePolicy p{c};
+  std::vector<CueInput> f = approach(0.0, StairKind::kAscending, 3.6f, 1.0);
+  for (double t = 1.0; t < 2.0; t += kDt) f.push_back(floor_frame(t));  // 1 s dropout
+  for (auto& x : approach(2.0, StairKind::kAscending, 2.6f, 1.0)) f.push_back(x);
+  for (double t = 3.0; t < 8.0; t += kDt) f.push_back(floor_frame(t));             // forgotten (> 3 s)
+  for (auto& x : approach(8.0, StairKind::kAscending, 3.0f, 1.0)) f.push_back(x);  // < 20 s: not again
+  auto s = feed(p, f);
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 1) << ::testing::PrintToString(toks(s));
+  // Long after: a staircase found again is announced again.
+  std::vector<CueInput> g;
+  for (double t = 9.0; t < 30.0; t += kDt) g.push_back(floor_frame(t));
+  for (auto& x : approach(30.0, StairKind::kAscending, 3.0f, 1.0)) g.push_back(x);
+  s = feed(p, g);
+  ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1);
+  EXPECT_GE(s.back().t, 30.0);
+}
+
+TEST(FeedbackPolicy, FarStairsWaitForAnnounceDistance) {
+  FeedbackConfig c;
+  c.announce_distance = 4.0f;
+  CuePolicy p{c};
+  const auto s = feed(p, approach(0.0, StairKind::kAscending, 7.0f, 4.0));
+  ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1);
+  const auto& e = s.back();
+  EXPECT_EQ(e.e.number, 4);
+  // 7 m at t=0, 1 m/s: within 4 m from t=3 s.
+  EXPECT_NEAR(e.t, 3.0, kDt + 1e-9);
+}
+
+TEST(FeedbackPolicy, DescendingWithinDangerDistanceAlwaysWarnsEvenQuiet) {
+  for (const char* v : {"quiet", "normal", "verbose"}) {
+    FeedbackConfig c;
+    c.verbosity = v;
+    CuePolicy p{c};
+    // Seen at 3.5 m (told as stairs ahead, going down), then nearer than 2 m: the warning.
+    const auto s = feed(p, approach(0.0, StairKind::kDescending, 3.5f, 3.0));
+    ASSERT_EQ(count_of(s, Cue::kDropWarning), 1) << v << ::testing::PrintToString(toks(s));
+    // Verbose too: no distance update between 3 m and the warning (rate limit), none after it.
+    ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1) << v << ::testing::PrintToString(toks(s));
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kDropWarning) {
+        EXPECT_EQ(x.e.number, 2) << v;
+        EXPECT_NEAR(x.t, 1.5, kDt + 1e-9) << v;  // 3.5 m - 1 m/s * 1.5 s = 2 m
+        EXPECT_EQ(x.e.priority, cue_priority(Cue::kDropWarning));
+        EXPECT_EQ(clips_for(x.e).front(), "warning");
+      } else if (x.e.cue == Cue::kStairsAhead) {
+        EXPECT_EQ(x.e.earcon_only, std::string(v) == "quiet");
+        EXPECT_EQ(x.e.direction, -1);
+      }
+  }
+  // First seen already near: only the warning; of unknown distance (no floor): the warning.
+  CuePolicy p{FeedbackConfig{}};
+  auto s = feed(p, approach(0.0, StairKind::kDescending, 1.5f, 1.0));
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "drop_warning_down:1m"}));
+  CuePolicy q{FeedbackConfig{}};
+  std::vector<CueInput> f;
+  for (int i = 0; i < 30; ++i) {
+    CueInput in = stair_frame(i * kDt, StairKind::kDescending, std::nanf(""));
+    in.floor_found = false;
+    in.stair.without_floor = true;
+    f.push_back(in);
+  }
+  s = feed(q, f);
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "drop_warning_down"}));
+}
+
+TEST(FeedbackPolicy, DropWarnedAgainOnlyAfterItWasForgotten) {
+  FeedbackConfig c;  // forget 3 s, repeat 20 s
+  CuePolicy p{c};
+  std::vector<CueInput> f = approach(0.0, StairKind::kDescending, 1.8f, 1.0);
+  for (double t = 1.0; t < 2.5; t += kDt) f.push_back(floor_frame(t));  // 1.5 s dropout: held
+  for (auto& x : approach(2.5, StairKind::kDescending, 1.5f, 0.5)) f.push_back(x);
+  auto s = feed(p, f);
+  EXPECT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
+  // Out of mind for 4 s (forgotten), back within 2 m, 5 s after the warning: warned again.
+  std::vector<CueInput> g;
+  for (double t = 3.0; t < 7.0; t += kDt) g.push_back(floor_frame(t));
+  for (auto& x : approach(7.0, StairKind::kDescending, 1.5f, 1.0)) g.push_back(x);
+  s = feed(p, g);
+  ASSERT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
+  EXPECT_NEAR(s.back().t, 7.0 + c.confirm_time, kDt + 1e-6);
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 0);
+}
+
+TEST(FeedbackPolicy, CurbsAndSingleSteps) {
+  CuePolicy p{FeedbackConfig{}};
+  auto s = feed(p, approach(0.0, StairKind::kCurb, 2.0f, 1.0));
+  std::vector<CueInput> in;
+  for (int i = 0; i < 30; ++i) {
+    CueInput x = stair_frame(5.0 + i * kDt, StairKind::kSingleStep, 1.5f);
+    x.stair.direction = -1;
+    in.push_back(x);
+  }
+  for (auto& x : feed(p, in)) s.push_back(x);
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "curb_up", "step_down"}));
+  EXPECT_EQ(clips_for(s[1].e), (std::vector<std::string>{"curb_up"}));
+  EXPECT_EQ(clips_for(s[2].e), (std::vector<std::string>{"step_down"}));
+}
+
+TEST(FeedbackPolicy, RateLimitBetweenTwoAnnouncements) {
+  FeedbackConfig c;
+  c.min_cue_interval = 1.5f;
+  CuePolicy p{c};
+  // An ascending staircase, then 0.5 s later a different one (descending, far): the second
+  // waits until 1.5 s after the first.
+  std::vector<CueInput> f = approach(0.0, StairKind::kAscending, 3.0f, 0.5);
+  for (double t = 0.5; t < 3.0; t += kDt) f.push_back(stair_frame(t, StairKind::kDescending, 3.5f));
+  const auto s = feed(p, f);
+  ASSERT_EQ(count_of(s, Cue::kStairsAhead), 2) << ::testing::PrintToString(toks(s));
+  std::vector<double> ts;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kStairsAhead) ts.push_back(x.t);
+  EXPECT_GE(ts[1] - ts[0], 1.5 - 1e-9);
+  EXPECT_LT(ts[1] - ts[0], 1.5 + kDt + 1e-9);
+}
+
+TEST(FeedbackPolicy, BlindToldOnceThenAtTheSlowInterval) {
+  FeedbackConfig c;  // blind after 3 s, again every 30 s
+  CuePolicy p{c};
+  std::vector<CueInput> f;
+  for (double t = 0; t < 70.0; t += kDt) {
+    CueInput in;
+    in.t = t;
+    in.floor_found = std::fabs(t - 40.0) < 0.02;  // one frame with a floor at 40 s
+    f.push_back(in);
+  }
+  const auto s = feed(p, f);
+  std::vector<double> ts;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kBlind) ts.push_back(x.t);
+  ASSERT_EQ(ts.size(), 3u) << ::testing::PrintToString(toks(s));
+  EXPECT_NEAR(ts[0], 3.0, kDt + 1e-6);
+  EXPECT_NEAR(ts[1] - ts[0], 30.0, kDt + 1e-6);
+  EXPECT_NEAR(ts[2] - ts[1], 30.0, kDt + 1e-6);  // the floor at 40 s did not reset the slow interval
+  for (const auto& x : s) EXPECT_FALSE(about_stairs(x.e));
+  // A stair in view (even without a floor) is not blind.
+  CuePolicy q{c};
+  std::vector<CueInput> g;
+  for (double t = 0; t < 10.0; t += kDt) {
+    CueInput in = stair_frame(t, StairKind::kAscending, std::nanf(""));
+    in.floor_found = false;
+    g.push_back(in);
+  }
+  EXPECT_EQ(count_of(feed(q, g), Cue::kBlind), 0);
+}
+
+TEST(FeedbackPolicy, CameraLostAndBackOnceEach) {
+  CuePolicy p{FeedbackConfig{}};
+  EXPECT_TRUE(p.camera_back(0.0).empty());
+  auto a = p.camera_lost(1.0);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].cue, Cue::kCameraLost);
+  EXPECT_TRUE(p.camera_lost(2.0).empty());
+  auto b = p.camera_back(3.0);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].cue, Cue::kCameraBack);
+}
+
+TEST(FeedbackPolicy, PrioritiesWarningAboveTick) {
+  EXPECT_GT(cue_priority(Cue::kDropWarning), cue_priority(Cue::kCameraLost));
+  EXPECT_GT(cue_priority(Cue::kCameraLost), cue_priority(Cue::kLastStep));
+  EXPECT_GT(cue_priority(Cue::kLastStep), cue_priority(Cue::kStairsAhead));
+  EXPECT_GT(cue_priority(Cue::kBlind), cue_priority(Cue::kStairsAhead));
+  EXPECT_GT(cue_priority(Cue::kStairsAhead), cue_priority(Cue::kReady));
+  EXPECT_GT(cue_priority(Cue::kReady), cue_priority(Cue::kCount));
+  EXPECT_GT(cue_priority(Cue::kCount), cue_priority(Cue::kTick));
+}
+
+namespace {
+
+/// A scripted traversal: 1 s of floor, the approach in stair_ahead (3 m -> 0.5 m over 2.5 s),
+/// then `steps` steps at 0.6 s each (on_stairs; last_step once climbed == steps - 1), arrived
+/// for 1 s, searching again.
+std::vector<CueInput> scripted_flight(int steps, int direction = 1, double step_s = 0.6) {
+  std::vector<CueInput> f;
+  double t = 0;
+  const StairKind kind = direction > 0 ? StairKind::kAscending : StairKind::kDescending;
+  auto tr_frame = [&](TraversalState st) {
+    CueInput in = floor_frame(t);
+    in.traversal.ran = true;
+    in.traversal.state = st;
+    in.traversal.kind = st == TraversalState::kSearching ? StairKind::kNone : kind;
+    in.traversal.direction = st == TraversalState::kSearching ? 0 : direction;
+    in.traversal.steps_known = steps;
+    return in;
+  };
+  for (; t < 1.0; t += kDt) f.push_back(tr_frame(TraversalState::kSearching));
+  for (double d = 3.0; d > 0.5; d -= kDt, t += kDt) {
+    CueInput in = tr_frame(TraversalState::kStairAhead);
+    in.traversal.in_view = true;
+    in.traversal.distance_m = static_cast<float>(d);
+    in.traversal.bearing_rad = 0.f;
+    f.push_back(in);
+  }
+  for (int climbed = 1; climbed <= steps; ++climbed) {
+    for (double s = 0; s < step_s; s += kDt, t += kDt) {
+      CueInput in = tr_frame(climbed >= steps - 1 ? TraversalState::kLastStep : TraversalState::kOnStairs);
+      in.traversal.step_index = climbed;
+      in.traversal.steps_climbed = climbed;
+      in.traversal.steps_left = steps - climbed;
+      in.traversal.last_known = true;
+      f.push_back(in);
+    }
+  }
+  for (double s = 0; s < 1.0; s += kDt, t += kDt) f.push_back(tr_frame(TraversalState::kArrived));
+  for (double s = 0; s < 2.0; s += kDt, t += kDt) f.push_back(tr_frame(TraversalState::kSearching));
+  return f;
+}
+
+}  // namespace
+
+TEST(FeedbackPolicy, ScriptedClimbInOrder) {
+  CuePolicy p{FeedbackConfig{}};  // count every 5 steps
+  const auto s = feed(p, scripted_flight(8));
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m", "first_step", "steps_left:7",
+                                               "tick", "tick", "tick", "count:5", "tick", "last_step", "tick",
+                                               "end_of_stairs"}));
+  // Each step cue on the frame its step was reached (0.6 s apart).
+  std::vector<double> ticks;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kTick || x.e.cue == Cue::kCount) ticks.push_back(x.t);
+  for (std::size_t i = 1; i < 4; ++i) EXPECT_NEAR(ticks[i] - ticks[i - 1], 0.6, kDt + 1e-9);
+}
+
+TEST(FeedbackPolicy, ScriptedDescentWarnsAndCounts) {
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, scripted_flight(4, -1));
+  // 3 m -> told; 2 m -> the drop warning; then the flight.
+  EXPECT_EQ(toks(s),
+            (std::vector<std::string>{"ready", "stairs_ahead_down:3m", "drop_warning_down:2m", "first_step",
+                                      "steps_left:3", "tick", "last_step", "tick", "end_of_stairs"}));
+}
+
+TEST(FeedbackPolicy, QuietFlightOnlyTheLastStep) {
+  FeedbackConfig c;
+  c.verbosity = "quiet";
+  CuePolicy p{c};
+  const auto s = feed(p, scripted_flight(8));
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m", "last_step"}));
+  EXPECT_TRUE(s[1].e.earcon_only);
+  EXPECT_EQ(clips_for(s[1].e), (std::vector<std::string>{"up"}));
+}
+
+TEST(FeedbackPolicy, VerboseDistancesAndStepsLeft) {
+  FeedbackConfig c;
+  c.verbosity = "verbose";
+  CuePolicy p{c};
+  const auto s = feed(p, scripted_flight(12));
+  EXPECT_EQ(toks(s),
+            (std::vector<std::string>{"ready", "stairs_ahead_up:3m@12", "stairs_ahead_up:1m@12", "first_step",
+                                      "steps_left:11", "tick", "tick", "tick", "steps_left:7", "tick", "tick",
+                                      "tick", "tick", "steps_left:2", "last_step", "tick", "end_of_stairs"}));
+}
+
+TEST(FeedbackPolicy, WarningCutsTickOnTheSameFrame) {
+  // The step that enters last_step would also tick: only the last step is given.
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, scripted_flight(3));
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"ready", "stairs_ahead_up:3m", "first_step", "steps_left:2",
+                                               "last_step", "tick", "end_of_stairs"}));
+}
+
+TEST(FeedbackPolicy, TicksRateLimitedOnAFlickeringCount) {
+  FeedbackConfig c;
+  c.count_interval = 100;
+  CuePolicy p{c};
+  // The tracker's count rises on 20 successive frames (a fault): ticks at most every 0.25 s.
+  std::vector<CueInput> f;
+  for (int i = 0; i < 40; ++i) {
+    CueInput in = floor_frame(i * kDt);
+    in.traversal.ran = true;
+    in.traversal.state = TraversalState::kOnStairs;
+    in.traversal.kind = StairKind::kAscending;
+    in.traversal.direction = 1;
+    in.traversal.steps_climbed = in.traversal.step_index = 1 + std::min(i, 20);
+    f.push_back(in);
+  }
+  const auto s = feed(p, f);
+  std::vector<double> ts;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kTick) ts.push_back(x.t);
+  ASSERT_GE(ts.size(), 2u);
+  EXPECT_LE(ts.size(), 3u);  // 20 frames = 0.67 s
+  for (std::size_t i = 1; i < ts.size(); ++i) EXPECT_GE(ts[i] - ts[i - 1], 0.25 - 1e-9);
+}
+
+TEST(FeedbackPolicy, ReconfigureVerbosityMidFlight) {
+  CuePolicy p{FeedbackConfig{}};
+  const auto f = scripted_flight(8);
+  std::vector<Said> s;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (i == f.size() / 2) {
+      FeedbackConfig q;
+      q.verbosity = "quiet";
+      p.reconfigure(q);
+    }
+    for (const auto& e : p.step(f[i])) s.push_back({f[i].t, e});
+  }
+  // No tick, count or end after the switch; the last step still told.
+  bool switched = false;
+  for (const auto& x : s) {
+    if (x.t >= f[f.size() / 2].t) switched = true;
+    if (switched) {
+      EXPECT_TRUE(x.e.cue == Cue::kLastStep) << token(x.e);
+    }
+  }
+  EXPECT_EQ(count_of(s, Cue::kLastStep), 1);
+}
+
+TEST(FeedbackPolicy, ClockGoingBackStartsAfresh) {
+  CuePolicy p{FeedbackConfig{}};
+  auto s = feed(p, approach(100.0, StairKind::kAscending, 3.0f, 1.0));
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 1);
+  s = feed(p, approach(0.0, StairKind::kAscending, 3.0f, 1.0));  // a reopened camera: t from 0
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 1);
+}
+
+TEST(FeedbackHapticPatterns, DirectionAndCountCoded) {
+  CueEvent up, down;
+  up.cue = down.cue = Cue::kStairsAhead;
+  up.direction = 1;
+  down.direction = -1;
+  const auto pu = haptic_pattern(up), pd = haptic_pattern(down);
+  ASSERT_EQ(pu.size(), 2u);
+  ASSERT_EQ(pd.size(), 2u);
+  EXPECT_LT(pu[0].on_ms, pu[1].on_ms);  // rising: short-long
+  EXPECT_GT(pd[0].on_ms, pd[1].on_ms);  // falling: long-short
+  CueEvent tick, last, drop, blind;
+  tick.cue = Cue::kTick;
+  last.cue = Cue::kLastStep;
+  drop.cue = Cue::kDropWarning;
+  blind.cue = Cue::kBlind;
+  EXPECT_EQ(haptic_pattern(tick).size(), 1u);
+  ASSERT_EQ(haptic_pattern(last).size(), 1u);
+  EXPECT_GE(haptic_pattern(last)[0].on_ms, 5 * haptic_pattern(tick)[0].on_ms);
+  EXPECT_EQ(haptic_pattern(drop).size(), 5u);
+  EXPECT_EQ(haptic_pattern(blind).size(), 3u);
+}
