@@ -23,6 +23,8 @@ class FolderReader {
   SourceError err(const YAML::Node& n, const std::string& why) const {
     return SourceError(file_ + ":" + std::to_string(n.Mark().line + 1) + ": " + why);
   }
+  /// err() with the mapping's name first ("folder stair 0: ...").
+  SourceError here(const YAML::Node& n, const std::string& why) const { return err(n, what_ + ": " + why); }
   bool has(const char* key) {
     seen_.insert(key);
     return static_cast<bool>(n_[key]);
@@ -112,20 +114,20 @@ bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
     t.id = s.optional<int>("id", static_cast<int>(f.stairs.size()));
     const std::string kind = s.scalar<std::string>("kind");
     if (!parse_stair_kind(kind, t.kind) || t.kind == StairKind::kNone)
-      throw s.err(sn["kind"], "unknown stair kind '" + kind + "' (ascending, descending, single_step, curb)");
+      throw s.here(sn["kind"], "unknown stair kind '" + kind + "' (ascending, descending, single_step, curb)");
     if (s.has("down")) {
       t.down = s.scalar<bool>("down");
       if ((t.kind == StairKind::kAscending || t.kind == StairKind::kSingleStep) && t.down)
-        throw s.err(sn["down"], std::string("a ") + to_string(t.kind) + " cannot go down ('down: true')");
+        throw s.here(sn["down"], std::string("a ") + to_string(t.kind) + " cannot go down ('down: true')");
       if (t.kind == StairKind::kDescending && !t.down)
-        throw s.err(sn["down"], "a descending staircase goes down ('down: false' given)");
+        throw s.here(sn["down"], "a descending staircase goes down ('down: false' given)");
     } else if (t.kind == StairKind::kCurb) {
-      throw s.err(sn, "a curb needs 'down: true' (the ground drops) or 'down: false' (it rises)");
+      throw s.here(sn, "a curb needs 'down: true' (the ground drops) or 'down: false' (it rises)");
     } else {
       t.down = t.kind == StairKind::kDescending;
     }
     t.steps = s.optional<int>("steps", 0);
-    if (t.steps < 0 || t.steps > 1000) throw s.err(sn["steps"], "key 'steps' must be 0 (unknown) to 1000");
+    if (t.steps < 0 || t.steps > 1000) throw s.here(sn["steps"], "key 'steps' must be 0 (unknown) to 1000");
     t.riser_m = s.length("riser_m", 1.f);
     t.tread_m = s.length("tread_m", 5.f);
     t.width_m = s.length("width_m", 50.f);
@@ -134,15 +136,15 @@ bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
     if (s.has("visible_steps")) {
       const YAML::Node v = sn["visible_steps"];
       if (!v.IsSequence())
-        throw s.err(v, "key 'visible_steps' must be a list of tread numbers (1 = the first)");
+        throw s.here(v, "key 'visible_steps' must be a list of tread numbers (1 = the first)");
       for (const auto& e : v) {
         int k = 0;
         try {
           k = e.as<int>();
         } catch (const YAML::Exception&) {
-          throw s.err(e, "key 'visible_steps' holds a non-integer");
+          throw s.here(e, "key 'visible_steps' holds a non-integer");
         }
-        if (k < 1) throw s.err(e, "key 'visible_steps': treads are numbered from 1");
+        if (k < 1) throw s.here(e, "key 'visible_steps': treads are numbered from 1");
         t.visible_steps.push_back(k);
       }
     } else {
