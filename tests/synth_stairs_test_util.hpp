@@ -18,7 +18,7 @@ struct SynthStairs {
   /// Renders frame `i` of `preset` (seed `seed`) and runs perception on it, from nothing when
   /// `cold` (an independent view), else tracking from the frames before.
   void perceive(const std::string& preset, long i, std::uint32_t seed, bool cold = false) {
-    stairguide::synth::render_preset_frame(preset, i, seed, stairguide::synth::SynthOptions{}, frame, truth);
+    stairguide::synth::render_preset_frame(preset, i, seed, options, frame, truth);
     if (cold) perception.reset();
     perception.process(frame, scene);
   }
@@ -34,6 +34,7 @@ struct SynthStairs {
   }
 
   stairguide::PipelineConfig cfg;
+  stairguide::synth::SynthOptions options;  ///< the sensor model (the suites: the defaults)
   stairguide::Perception perception;
   stairguide::StairStage stage;
   stairguide::RgbdFrame frame;

@@ -54,8 +54,10 @@ TEST(Config, PaperValuesAreTheDefaults) {
   EXPECT_FLOAT_EQ(c.floor.height_min, 1.0f);
   EXPECT_FLOAT_EQ(c.floor.height_max, 1.6f);
   EXPECT_NEAR(c.classification.parallel_threshold, 10.0 * M_PI / 180.0, 1e-6);
-  EXPECT_FLOAT_EQ(c.classification.step_height_min, 0.13f);
-  EXPECT_FLOAT_EQ(c.classification.step_height_max, 0.185f);
+  // The building code is the world's, not the paper's Spanish one (config/profiles/paper.yaml
+  // holds that; Config.PaperProfileIsTheSpanishCode).
+  EXPECT_FLOAT_EQ(c.classification.step_height_min, 0.10f);
+  EXPECT_FLOAT_EQ(c.classification.step_height_max, 0.22f);
   EXPECT_FLOAT_EQ(c.stair_detection.same_level_tolerance, 0.03f);
   EXPECT_FLOAT_EQ(c.stair_detection.connection_radius, 0.5f);
   EXPECT_EQ(c.stair_detection.connection_min_points, 10);
@@ -66,6 +68,37 @@ TEST(Config, PaperValuesAreTheDefaults) {
   // two more coarse levels cost little, so 5 is the shipped default (see OdometryConfig).
   EXPECT_EQ(c.odometry.pyramid_levels, 5);
   EXPECT_EQ(c.odometry.iterations, 10);
+}
+
+// The defaults accept the stairs of the world's building codes (../shared/data/SOURCES.md); the
+// paper's profile loads and restores its Spanish code (CTE DB-SUA), every other key left at its
+// default.
+TEST(Config, PaperProfileIsTheSpanishCode) {
+  const PipelineConfig d;
+  EXPECT_FLOAT_EQ(d.stair_modelling.riser_min, 0.10f);
+  EXPECT_FLOAT_EQ(d.stair_modelling.riser_max, 0.22f);
+  EXPECT_FLOAT_EQ(d.stair_modelling.tread_min, 0.20f);
+  EXPECT_FLOAT_EQ(d.stair_modelling.blondel_min, 0.50f);
+  EXPECT_FLOAT_EQ(d.stair_modelling.blondel_max, 0.72f);
+  EXPECT_FLOAT_EQ(d.stair_modelling.width_min, 0.60f);
+  ConfigLoadReport report;
+  const PipelineConfig p =
+      load_config(std::string(STAIRGUIDE_SOURCE_DIR) + "/config/profiles/paper.yaml", &report);
+  EXPECT_FLOAT_EQ(p.classification.step_height_min, 0.13f);
+  EXPECT_FLOAT_EQ(p.classification.step_height_max, 0.185f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.riser_min, 0.13f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.riser_max, 0.185f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.tread_min, 0.28f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.blondel_min, 0.54f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.blondel_max, 0.70f);
+  EXPECT_FLOAT_EQ(p.stair_modelling.width_min, 0.60f);
+  // Nothing else moves: put the eight keys back and the profile is the defaults.
+  PipelineConfig back = p;
+  back.classification.step_height_min = d.classification.step_height_min;
+  back.classification.step_height_max = d.classification.step_height_max;
+  back.stair_modelling = d.stair_modelling;
+  std::string diff;
+  EXPECT_TRUE(config_equal(back, d, &diff)) << "the profile also changes " << diff;
 }
 
 TEST(Config, UnitsAreConvertedToSi) {

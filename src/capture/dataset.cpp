@@ -193,7 +193,10 @@ DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& optio
   const std::string gt = (d / "groundtruth.txt").string();
   if (fs::exists(gt, ec)) groundtruth_ = read_groundtruth(gt);
   const std::string labels = (d / "labels.yaml").string();
-  if (fs::exists(labels, ec)) {
+  FrameTruth folder;
+  if (fs::exists(labels, ec) && read_folder_label_yaml(labels, folder)) {
+    folder_label_ = std::move(folder);
+  } else if (fs::exists(labels, ec)) {
     labels_ = read_labels_yaml(labels);
     std::stable_sort(labels_.begin(), labels_.end(),
                      [](const FrameTruth& a, const FrameTruth& b) { return a.timestamp < b.timestamp; });
@@ -205,6 +208,7 @@ std::string DatasetSource::describe() const {
   if (skipped_ > 0) s += ", " + std::to_string(skipped_) + " depth images without colour skipped";
   if (!groundtruth_.empty()) s += ", ground-truth poses";
   if (!labels_.empty()) s += ", labels";
+  if (folder_label_) s += ", one label for the folder";
   return s + ")";
 }
 
@@ -251,6 +255,12 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
 }
 
 std::optional<FrameTruth> DatasetSource::truth() const {
+  if (have_last_ && folder_label_) {
+    FrameTruth t = *folder_label_;
+    t.index = last_index_;
+    t.timestamp = last_t_;
+    return t;
+  }
   if (!have_last_ || labels_.empty()) return std::nullopt;
   // Labels are matched by timestamp (1 ms: lists carry 6 decimals), else by frame index.
   auto it = std::lower_bound(labels_.begin(), labels_.end(), last_t_,

@@ -23,8 +23,9 @@ long parse_count(const std::string& s, const std::string& input, const char* wha
 }
 
 std::unique_ptr<FrameSource> open_synth(const std::string& input) {
-  // synth:SCENE[:FRAMES[:SEED[:NOISE]]], NOISE white (the default) or kinect
-  // (synth::with_real_kinect_noise: correlated in space as the real sensor's)
+  // synth:SCENE[:FRAMES[:SEED[:NOISE]]], NOISE white (the default), kinect
+  // (synth::with_real_kinect_noise: correlated in space as the real sensor's), or real-v1 / real-v2
+  // (synth::with_real_artefacts: the real frames' holes, dark faces, flying pixels; Kinect v1 or v2)
   std::vector<std::string> parts;
   std::size_t start = 0;
   for (;;) {
@@ -39,6 +40,8 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
   long frames = -1;
   for (const auto& p : synth::presets())
     if (p.name == parts[1]) frames = p.default_frames;
+  for (const auto& p : synth::world_presets())
+    if (p.name == parts[1]) frames = p.default_frames;
   if (parts.size() >= 3 && !parts[2].empty()) frames = parse_count(parts[2], input, "FRAMES");
   if (frames == 0) throw SourceError("input '" + input + "': FRAMES must be at least 1");
   std::uint32_t seed = 1;
@@ -46,8 +49,13 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
   synth::SynthOptions options;
   if (parts.size() == 5) {
     if (parts[4] == "kinect") options = synth::with_real_kinect_noise(options);
+    else if (parts[4] == "real-v1")
+      options = synth::with_real_artefacts(synth::RealSensor::kKinectV1, options);
+    else if (parts[4] == "real-v2")
+      options = synth::with_real_artefacts(synth::RealSensor::kKinectV2, options);
     else if (parts[4] != "white")
-      throw SourceError("input '" + input + "': NOISE must be 'white' or 'kinect', got '" + parts[4] + "'");
+      throw SourceError("input '" + input +
+                        "': NOISE must be 'white', 'kinect', 'real-v1' or 'real-v2', got '" + parts[4] + "'");
   }
   // An unknown scene name is reported by make_source (its message lists the presets).
   return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed, options);

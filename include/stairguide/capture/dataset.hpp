@@ -10,7 +10,8 @@
 ///   depth/           16-bit single-channel PNG, 0 = no reading
 ///   rgb/             colour images, same size as depth (colour registered to depth when it can be)
 ///   groundtruth.txt  optional, TUM "timestamp tx ty tz qx qy qz qw", camera-to-world (T_world_camera)
-///   labels.yaml      optional, per-frame FrameTruth (see ground_truth.hpp), written by `stairguide synth`
+///   labels.yaml      optional, per-frame FrameTruth (see ground_truth.hpp), written by `stairguide synth`;
+///                    or one label for the whole folder, written by hand (read_folder_label_yaml)
 
 #include <cstdio>
 #include <memory>
@@ -36,6 +37,31 @@ void write_camera_yaml(const std::string& path, const DatasetCamera& camera, con
 std::string labels_to_yaml(const std::vector<FrameTruth>& frames);
 /// Parses labels.yaml; throws SourceError naming the file, the line and the key on any problem.
 std::vector<FrameTruth> read_labels_yaml(const std::string& path);
+
+/// A whole-folder label, written by hand for a folder of real frames: labels.yaml of the same
+/// format ("format: stairguide-labels-1") with one `folder:` mapping instead of the `frames:` list.
+/// It holds a frame's keys that a person can say of every frame without a pose:
+///   folder:
+///     scene: "7scenes-stairs-seq04"      required, a name for the tables
+///     floor_visible: false               optional (false)
+///     camera_height_m: 0                 optional, 0 = unknown
+///     stairs:                            required ([] for a stair-free folder)
+///       - kind: ascending                required: ascending, descending, single_step, curb
+///         down: false                    required for a curb; must agree with the other kinds
+///         steps: 9                       optional (0 = unknown)
+///         riser_m: 0.152                 optional, 0 = unknown; when given, riser errors are scored
+///         tread_m: 0.245                 optional, likewise
+///         width_m: 1.27                  optional
+///         open_risers: false             optional
+///         visible_steps: [1, 2]          optional: treads in view in every frame ([1, 2]; [1] for one step)
+///         first_edge_visible: true       optional (true)
+///         both_ends_visible: false       optional (false)
+/// Per-frame keys (index, timestamp, T_world_camera, camera_tilt_rad, camera_roll_rad,
+/// T_camera_stair, visible_pixels, user_step) are refused by name: a folder has no one value of
+/// them. Returns false (and leaves `out` alone) when the file holds a `frames:` list instead, so
+/// read_labels_yaml reads it; throws SourceError naming the file, the line and the key on any
+/// problem. The label comes back with pose_known = false and index/timestamp 0.
+bool read_folder_label_yaml(const std::string& path, FrameTruth& out);
 
 /// One line of groundtruth.txt.
 struct TimedPose {
@@ -74,7 +100,7 @@ class DatasetSource : public FrameSource {
   std::optional<Pose> pose() const;
   /// All poses of groundtruth.txt (empty without the file).
   const std::vector<TimedPose>& groundtruth() const { return groundtruth_; }
-  bool has_labels() const { return !labels_.empty(); }
+  bool has_labels() const { return !labels_.empty() || folder_label_.has_value(); }
 
  private:
   struct Pair {
@@ -87,6 +113,7 @@ class DatasetSource : public FrameSource {
   std::vector<Pair> pairs_;
   std::vector<TimedPose> groundtruth_;
   std::vector<FrameTruth> labels_;  ///< sorted by timestamp
+  std::optional<FrameTruth> folder_label_;  ///< a whole-folder labels.yaml (read_folder_label_yaml)
   long skipped_ = 0;
   long next_ = 0;
   double last_t_ = -1.0;

@@ -28,6 +28,13 @@ struct PresetInfo {
 /// distractors, occluding people, rotated staircase, ...).
 const std::vector<PresetInfo>& presets();
 
+/// The world's stairs: presets that draw riser, tread, width, nosing, open risers and landings
+/// from the range of the building codes of the world (../shared/data/SOURCES.md: risers 10-22 cm,
+/// treads 20-45 cm, 2R+T 50-72 cm, widths 0.65-2.6 m, 2-14 steps) rather than the paper's. Not in
+/// presets(): the suites' figures rest on those draws. Every synth: input and make_source take
+/// their names.
+const std::vector<PresetInfo>& world_presets();
+
 /// Sensor and trajectory options common to every preset.
 struct SynthOptions {
   bool noise = true;  ///< Kinect-like depth noise, quantisation, holes
@@ -61,6 +68,20 @@ struct SynthOptions {
   float noise_short_px = 2.f;   ///< px
   float noise_long_share = 0.f;
   float noise_long_px = 10.f;   ///< px
+  // ---- artefacts seen on the real frames; all off by default (the suites were measured without).
+  // Not part of the ground truth's visibility (like the random dropout). with_real_artefacts(). ----
+  float speckle_holes = 0.f;  ///< share of the image lost in small blobs (radius 1-3 px) at random
+  float dark_surface_chance =
+      0.f;  ///< chance that a face is dark (half of them) or glossy (the other half) ...
+  float dark_surface_range_m = 2.0f;  ///< m, ... a dark face gives no reading beyond this; a glossy one none
+                                      ///< where it faces the ray within 12 deg
+  float flying_pixels = 0.f;  ///< chance that a pixel beside a depth jump reads a depth between the two sides
+  /// Kinect v2 (time of flight) instead of v1 (structured light): Gaussian depth noise of sigma
+  /// tof_sigma_m + tof_sigma_per_m2 * z^2 rounded to depth_step_m, no disparity quantisation and no
+  /// projector shadows; grazing and jump holes as before.
+  bool time_of_flight = false;
+  float tof_sigma_m = 0.0015f;       ///< m
+  float tof_sigma_per_m2 = 0.0005f;  ///< 1/m
   float color_noise = 2.0f;          ///< grey levels, sigma of the colour noise
   double fps = 30.0;                 ///< Hz, frame rate of the timestamps
 };
@@ -71,6 +92,16 @@ struct SynthOptions {
 /// less. Shares 0.6 over 2 px and 0.4 over 10 px give 0.77, 0.40 and 0.22 (PerceptionRealData.
 /// SyntheticNoiseCorrelatedAsTheRealClouds).
 SynthOptions with_real_kinect_noise(SynthOptions o = {});
+
+/// Which real sensor's artefacts with_real_artefacts() adds.
+enum class RealSensor { kKinectV1, kKinectV2 };
+
+/// `o` with the artefacts of the real frames of ../shared/data: speckle holes (0.5% of the image),
+/// dark or glossy faces (one in ten: a dark one reads nothing beyond 2 m, a glossy one nothing
+/// where it faces the ray), flying pixels at depth jumps (30%);
+/// Kinect v1: the real-like correlated noise (with_real_kinect_noise) and its disparity
+/// quantisation; Kinect v2: time of flight at 512x424.
+SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o = {});
 
 /// Everything needed to render one frame of a preset: the scene and the walker's state.
 struct PresetFrame {

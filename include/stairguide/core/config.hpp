@@ -396,8 +396,8 @@ struct ManhattanConfig {
 
 struct ClassificationConfig {
   float parallel_threshold = 0.17453293f;  ///< rad, parallel/perpendicular tolerance (10 deg)
-  float step_height_min = 0.13f;           ///< m, H_min
-  float step_height_max = 0.185f;          ///< m, H_max
+  float step_height_min = 0.10f;           ///< m, H_min (the world's codes; the paper's: 0.13)
+  float step_height_max = 0.22f;           ///< m, H_max (the world's codes; the paper's: 0.185)
   float floor_height_tolerance = 0.04f;    ///< m, a horizontal plane this close to 0 is floor
   float step_height_tolerance = 0.02f;     ///< m, noise margin below H_min for step candidates
 
@@ -470,11 +470,14 @@ struct StairDetectionConfig {
 };
 
 struct StairModellingConfig {
-  float riser_min = 0.13f;        ///< m, building code
-  float riser_max = 0.185f;       ///< m
-  float tread_min = 0.28f;        ///< m
-  float blondel_min = 0.54f;      ///< m, 2R + T lower bound
-  float blondel_max = 0.70f;      ///< m, 2R + T upper bound
+  // Defaults: the range of the world's building codes (../shared/data/SOURCES.md: USA IRC/IBC, UK
+  // Approved Document K, Germany DIN 18065, Spain CTE); config/profiles/paper.yaml restores the
+  // paper's Spanish code (riser 13-18.5, tread >= 28, 2R+T 54-70 cm).
+  float riser_min = 0.10f;        ///< m, building code
+  float riser_max = 0.22f;        ///< m
+  float tread_min = 0.20f;        ///< m
+  float blondel_min = 0.50f;      ///< m, 2R + T lower bound
+  float blondel_max = 0.72f;      ///< m, 2R + T upper bound
   float width_min = 0.6f;         ///< m
   float manhattan_min_fraction = 0.1f;  ///< share of Manhattan points to use the Manhattan axes
   float manhattan_max_disagreement = 0.08726646f;  ///< rad, Manhattan axes used only within this of the steps' own axes (5 deg)

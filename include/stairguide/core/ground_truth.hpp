@@ -63,6 +63,10 @@ struct FrameTruth {
   /// at least 8 cm tall, within range, where the depth sensor gives a reading): what the
   /// Manhattan frame is built from. 0 for dataset frames.
   int wall_or_riser_pixels = 0;
+  /// False for a whole-folder label written by hand (dataset.hpp, read_folder_label_yaml): no
+  /// per-frame pose, so T_world_camera and every T_camera_stair are unknown and a detection is
+  /// scored by its direction (and by riser and tread where the label gives them), not its place.
+  bool pose_known = true;
 
   /// Staircases with at least one visible step or a visible first edge.
   bool any_stair_visible() const;

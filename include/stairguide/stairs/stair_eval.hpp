@@ -76,7 +76,8 @@ const char* kind_label(StairKind kind, bool down);
 struct StairEvalOptions {
   float match_distance = 0.25f;  ///< m, first edges farther apart than this do not match
   /// Labels without a pose (e.g. labels.csv: stair / none and a kind): a detection matches a
-  /// visible truth stair going the same way, wherever it is; no pose errors are computed.
+  /// visible truth stair going the same way, wherever it is; no pose errors are computed (riser
+  /// and tread errors are, where the truth gives them: a whole-folder label measured by hand).
   bool ignore_pose = false;
 };
 

@@ -1,5 +1,6 @@
 // `stairguide eval INPUT... [--json]`: stair detection and modelling scored against ground truth.
-// Inputs: dataset folders with labels.yaml, "synth:PRESET[:FRAMES[:SEED[:NOISE]]]" (the renderer directly;
+// Inputs: dataset folders with labels.yaml (per frame, or one label for the whole folder written by
+// hand: dataset.hpp, read_folder_label_yaml), "synth:PRESET[:FRAMES[:SEED[:NOISE]]]" (the renderer directly;
 // "synth:all:FRAMES:SEED" runs every preset), or a labels.csv of single frames (path,label,kind,note;
 // paths relative to the file) whose labels carry no pose. The accuracy claims come from here.
 #include <cstdio>
@@ -23,6 +24,8 @@ namespace {
 
 bool is_static_preset(const std::string& name) {
   for (const auto& p : synth::presets())
+    if (p.name == name) return p.default_frames == 1;
+  for (const auto& p : synth::world_presets())
     if (p.name == name) return p.default_frames == 1;
   return false;
 }
@@ -112,11 +115,17 @@ bool run_source(Runner& run, const std::string& input, const PipelineConfig& con
     }
     const auto truth = source->truth();
     if (!truth) {
-      error = "input '" + input + "' has no labels (a dataset folder needs labels.yaml; see 'stairguide synth')";
+      error =
+          "input '" + input +
+          "' has no labels (a dataset folder needs labels.yaml: per frame, see 'stairguide synth', or one "
+          "'folder:' label written by hand, see the README)";
       return false;
     }
     const std::string scene = truth->scene.empty() ? input : truth->scene;
-    run.frame(frame, *truth, n == 0 || is_static_preset(truth->scene), {}, scene);
+    // A whole-folder label written by hand has no pose: detections are matched by direction.
+    StairEvalOptions opt;
+    opt.ignore_pose = !truth->pose_known;
+    run.frame(frame, *truth, n == 0 || is_static_preset(truth->scene), opt, scene);
     ++n;
     if (run.progress && n % 20 == 0) std::fprintf(stderr, "\r%s: %ld frames", input.c_str(), n);
   }

@@ -25,12 +25,16 @@ int synth_cmd(Context& ctx) {
   if (list) {
     for (const auto& p : synth::presets())
       std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
+    for (const auto& p : synth::world_presets())
+      std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
     return 0;
   }
   if (!scene) throw UsageError("--scene NAME is required (see --list)");
   if (!out) throw UsageError("--out DIR is required");
   const synth::PresetInfo* preset = nullptr;
   for (const auto& p : synth::presets())
+    if (p.name == *scene) preset = &p;
+  for (const auto& p : synth::world_presets())
     if (p.name == *scene) preset = &p;
   if (!preset) {
     std::string names;
