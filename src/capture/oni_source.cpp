@@ -128,10 +128,11 @@ ReadResult OniSource::read(RgbdFrame& out) {
   const int timeout_ms = std::max(1, static_cast<int>(std::lround(m.options.frame_timeout * 1000.0)));
   std::string why;
   // A readFrame past the last frame blocks in manual mode, hence the frame count above; a
-  // recording shorter than it announces (truncated) shows as a wait that times out.
+  // recording shorter than it announces (truncated) shows as a wait that times out. That is an
+  // error, not an end: the frames it announced are missing (the ones before it were delivered).
   if (!m.read_one(m.depth, m.depth_ref, timeout_ms, why)) {
     m.ended = true;
-    return {ReadStatus::kEnd, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
+    return {ReadStatus::kError, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
                                   " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
   }
   if (!depth_frame_to_metres(m.depth_ref, out.depth)) {
