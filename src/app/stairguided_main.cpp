@@ -60,6 +60,11 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
         return false;
       }
       out = argv[++i];
+      // An empty FILE would read as "not given" below: `--replay ""` started the live camera.
+      if (out.empty()) {
+        err = s + " needs a non-empty value";
+        return false;
+      }
       return true;
     };
     if (s == "--config") {
@@ -95,6 +100,22 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
   }
   return true;
 }
+
+// The stop and reload signals are blocked before anything else can run: the executable's
+// .preinit_array runs before the constructors of every shared library (OpenCV, PCL, VTK and
+// their ~190 dependencies take most of the start-up), so a SIGTERM sent while they load waits
+// for the signal thread instead of killing the process (exit 143). Only the dynamic loader's own
+// mapping and relocation of those libraries comes before this.
+void block_stop_signals(int, char**, char**) {
+  sigset_t sigs;
+  sigemptyset(&sigs);
+  sigaddset(&sigs, SIGTERM);
+  sigaddset(&sigs, SIGINT);
+  sigaddset(&sigs, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
+}
+__attribute__((section(".preinit_array"), used)) void (*const block_stop_signals_early)(int, char**, char**) =
+    block_stop_signals;
 
 }  // namespace
 
