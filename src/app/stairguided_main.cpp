@@ -101,11 +101,11 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
   return true;
 }
 
-// The stop and reload signals are blocked before anything else can run: the executable's
-// .preinit_array runs before the constructors of every shared library (OpenCV, PCL, VTK and
-// their ~190 dependencies take most of the start-up), so a SIGTERM sent while they load waits
-// for the signal thread instead of killing the process (exit 143). Only the dynamic loader's own
-// mapping and relocation of those libraries comes before this.
+// `stairguided` is a static launcher (stairguided_launcher.cpp) that blocks the stop and reload
+// signals and execs this binary: the mask survives the exec, so a SIGTERM sent while the ~190
+// shared libraries load waits for the signal thread instead of killing the process (exit 143).
+// Run directly, this binary blocks them from its .preinit_array, before the libraries'
+// constructors though after the dynamic loader's relocations (most of the start-up).
 void block_stop_signals(int, char**, char**) {
   sigset_t sigs;
   sigemptyset(&sigs);
