@@ -147,6 +147,9 @@ TEST(HostilePcd, HeadersClaimingHugeSizesAreRefusedWithTheFileNamed) {
        "WIDTH '99999999999999999999999' is not a whole number"},
       {"nodata.pcd", "VERSION 0.7\n" + kXyz + "WIDTH 2\nHEIGHT 2\nPOINTS 4\n" + std::string(70000, 'x'),
        "header has no DATA line"},
+      // Found by tools/fuzz: PCL took "VIrmat" for a header key, its parse went wrong and it crashed.
+      {"vi.pcd", "# .PCD v0.7\nVIrmat\nVERSION 0.7\n" + kXyz + "WIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n",
+       "corrupt PCD header (unknown line 'VIrmat')"},
       {"twice.pcd", "VERSION 0.7\n" + kXyz + "WIDTH 2\nWIDTH 4000\nHEIGHT 2\nPOINTS 4\nDATA ascii\n",
        "WIDTH given twice"},
   };

@@ -5,7 +5,9 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -107,6 +109,12 @@ void check_pcd_header(const std::string& path) {
     std::string key, v;
     ss >> key;
     if (key.empty() || key[0] == '#') continue;
+    // PCL matches header keys by their first letters: a line "VIrmat" (found by fuzzing) left
+    // its parse half done and crashed it. Only the keys of the format pass.
+    static const char* const kKeys[] = {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT",
+                                        "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+    if (std::none_of(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }))
+      throw SourceError(path + ": corrupt PCD header (unknown line '" + key.substr(0, 40) + "')");
     auto& values = h[key];
     if (!values.empty()) throw SourceError(path + ": corrupt PCD header (" + key + " given twice)");
     while (ss >> v) values.push_back(v);
@@ -117,6 +125,8 @@ void check_pcd_header(const std::string& path) {
   }
   for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
     if (h[key].empty()) throw SourceError(path + ": not a PCD file (header has no " + key + " line)");
+  if (h.count("VIEWPOINT") && h["VIEWPOINT"].size() != 7)
+    throw SourceError(path + ": corrupt PCD header (VIEWPOINT needs 7 numbers)");
   if (header_end < 0) throw SourceError(path + ": not a PCD file (no DATA line in the first 64 lines)");
   const auto& fields = h["FIELDS"];
   if (h["SIZE"].size() != fields.size() || h["TYPE"].size() != fields.size())
