@@ -17,6 +17,7 @@
 #include "capture_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
+#include "stairguide/capture/oni.hpp"
 
 namespace fs = std::filesystem;
 using namespace stairguide;
@@ -260,4 +261,60 @@ TEST(HostileFiles, FifosAndDevicesInPlaceOfDatasetFilesAreRefusedAtOnce) {
   e = error_of([&] { DatasetSource s(d.string()); });
   EXPECT_NE(e.find("camera.yaml"), std::string::npos) << e;
   EXPECT_NE(e.find("not a regular file"), std::string::npos) << e;
+}
+
+TEST(HostileOni, RecordsOpenNI2sPlayerWouldTrustAreRefusedBeforeItSeesThem) {
+  // Found by tests/fuzz/fuzz_oni: a property record's name and the next record's header
+  // overwritten; OpenNI2's player read past its buffers and crashed (exit 139 from the daemon).
+  const std::string known = std::string(STAIRGUIDE_SOURCE_DIR) + "/tests/fuzz/corpus/oni/crash-player-property.oni";
+  std::string e = error_of([&] { OniSource s(known); });
+  EXPECT_NE(e.find("crash-player-property.oni: corrupt recording (record at byte 736: name not a string)"),
+            std::string::npos)
+      << e;
+  const fs::path good = scratch("good.oni");
+  const auto frames = test::make_frames(2, 32, 24, 1, 3000, 5.0);
+  {
+    OniWriter w(good.string(), frames[0].intrinsics, true);
+    for (const auto& f : frames) w.write(f);
+    w.close();
+  }
+  {
+    OniSource s(good.string());
+    RgbdFrame f;
+    EXPECT_TRUE(s.read(f).ok());
+  }
+  e = error_of([&] {
+    OniSource s(std::string(STAIRGUIDE_SOURCE_DIR) + "/tests/fuzz/corpus/oni/crash-no-cropping.oni");
+  });
+  EXPECT_NE(e.find("crash-no-cropping.oni: corrupt recording (record at byte 1094: name not a string)"),
+            std::string::npos)
+      << e;
+  const std::string bytes = read_all(good);
+  // The colour stream's cropping property renamed: the player crashed once its frames came.
+  const auto crop = bytes.rfind("xnCropping");
+  ASSERT_NE(crop, std::string::npos);
+  struct Case {
+    std::size_t at;  // byte to overwrite
+    std::string with;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {98, "XXXX", "record at byte 98: no NIR signature"},
+      {98 + 4, le32(77), "record at byte 98: unknown type 77"},
+      {98 + 12, le32(12), "record at byte 98: header size 12"},
+      {98 + 28, le32(5000), "record at byte 98: name length 5000"},
+      {24 + 16, le32(999), "record at byte 24: a payload on a record that has none"},
+      // Also found by fuzz_oni: OpenNI2's player allocated 6 GB for the streams this announced.
+      {20, le32(2752514), "the file header announces 2752514 streams"},
+      {crop + 9, "G", "stream 2 has no xnCropping property"},
+  };
+  for (const auto& c : cases) {
+    std::string mutated = bytes;
+    mutated.replace(c.at, c.with.size(), c.with);
+    const fs::path p = scratch("mutated.oni");
+    write_bytes(p, mutated);
+    e = error_of([&] { OniSource s(p.string()); });
+    EXPECT_NE(e.find("mutated.oni: corrupt recording ("), std::string::npos) << e;
+    EXPECT_NE(e.find(c.expect), std::string::npos) << e;
+  }
 }
