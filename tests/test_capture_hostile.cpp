@@ -38,10 +38,11 @@ std::string le32(std::uint32_t v) {
   return s;
 }
 
-std::string pcd_header(const std::string& fields_size_type_count, int w, int h, long points, const char* data) {
+std::string pcd_header(const std::string& fields_size_type_count, int w, int h, long points,
+                       const char* data) {
   return "# .PCD v0.7\nVERSION 0.7\n" + fields_size_type_count + "WIDTH " + std::to_string(w) + "\nHEIGHT " +
-         std::to_string(h) + "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " + data +
-         "\n";
+         std::to_string(h) + "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " +
+         data + "\n";
 }
 const std::string kXyz = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
 
@@ -107,14 +108,16 @@ TEST(HostilePcd, CompressedBodyWithAWrongUncompressedSizeIsRefusedBeforePclReads
   zero.replace(body + 4, 4, le32(0));
   write_bytes(d / "zero.pcd", zero);
   std::string e = error_of([&] { read_pcd_frame((d / "zero.pcd").string()); });
-  EXPECT_NE(e.find("zero.pcd: corrupt PCD (compressed body says 0 bytes uncompressed"), std::string::npos) << e;
+  EXPECT_NE(e.find("zero.pcd: corrupt PCD (compressed body says 0 bytes uncompressed"), std::string::npos)
+      << e;
   EXPECT_NE(e.find("192 points of 12 bytes are 2304"), std::string::npos) << e;
   // A compressed size beyond the end of the file.
   std::string longer = bytes;
   longer.replace(body, 4, le32(1u << 30));
   write_bytes(d / "beyond.pcd", longer);
   e = error_of([&] { read_pcd_frame((d / "beyond.pcd").string()); });
-  EXPECT_NE(e.find("beyond.pcd: truncated or corrupt PCD (compressed body of 1073741824 bytes"), std::string::npos)
+  EXPECT_NE(e.find("beyond.pcd: truncated or corrupt PCD (compressed body of 1073741824 bytes"),
+            std::string::npos)
       << e;
   // The same through open_frame_source (what every command uses).
   e = error_of([&] { open_frame_source((d / "zero.pcd").string(), CaptureConfig{}); });
@@ -133,13 +136,15 @@ TEST(HostilePcd, HeadersClaimingHugeSizesAreRefusedWithTheFileNamed) {
       // 8.5 GB of RSS before: ascii and compressed bodies were allocated from the header.
       {"wide.pcd", pcd_header(kXyz, 60000, 60000, 3600000000L, "ascii") + "0 0 1\n",
        "PCD WIDTH 60000 x HEIGHT 60000 is out of range [1, 16384] each"},
-      {"many.pcd", pcd_header(kXyz, 16000, 16000, 256000000L, "binary_compressed") + le32(10) + le32(0) + "0123456789",
+      {"many.pcd",
+       pcd_header(kXyz, 16000, 16000, 256000000L, "binary_compressed") + le32(10) + le32(0) + "0123456789",
        "PCD of 256000000 points is more than 16777216"},
       {"ascii_short.pcd", pcd_header(kXyz, 640, 480, 307200, "ascii") + "0 0 1\n",
        "truncated PCD (ascii data of 6 bytes cannot hold 307200 points of 3 values)"},
       // std::bad_alloc with no file named before.
       {"count.pcd",
-       pcd_header("FIELDS x y z d\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1000000\n", 4, 4, 16, "ascii") + "0 0 1 1\n",
+       pcd_header("FIELDS x y z d\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1000000\n", 4, 4, 16, "ascii") +
+           "0 0 1 1\n",
        "PCD field 'd' COUNT 1000000 is out of range [1, 1024]"},
       {"size.pcd", pcd_header("FIELDS x y z\nSIZE 4 4 3\nTYPE F F F\nCOUNT 1 1 1\n", 4, 4, 16, "ascii"),
        "field 'z' SIZE 3; 1, 2, 4 or 8 expected"},
@@ -168,7 +173,8 @@ TEST(HostilePcd, HeadersClaimingHugeSizesAreRefusedWithTheFileNamed) {
 TEST(HostileYaml, CameraYamlWithADuplicateKeyOrASecondDocumentIsRefused) {
   const fs::path d = scratch("camera");
   fs::create_directories(d);
-  const std::string good = "fx: 525\nfy: 525\ncx: 319.5\ncy: 239.5\nwidth: 640\nheight: 480\ndepth_scale: 5000\n";
+  const std::string good =
+      "fx: 525\nfy: 525\ncx: 319.5\ncy: 239.5\nwidth: 640\nheight: 480\ndepth_scale: 5000\n";
   write_bytes(d / "camera.yaml", good);
   EXPECT_FLOAT_EQ(read_camera_yaml((d / "camera.yaml").string()).intrinsics.fx, 525.f);
   write_bytes(d / "camera.yaml", good + "fx: 0\n");
@@ -203,7 +209,8 @@ TEST(HostileYaml, LabelsWithADuplicateKeyASecondDocumentOrANanPoseAreRefused) {
   write_bytes(labels, nan);
   e = error_of([&] { read_labels_yaml(labels.string()); });
   EXPECT_NE(e.find("T_camera_stair' holds a number that is not finite"), std::string::npos) << e;
-  const int nan_line = 1 + static_cast<int>(std::count(nan.begin(), nan.begin() + static_cast<long>(stair_at), '\n'));
+  const int nan_line =
+      1 + static_cast<int>(std::count(nan.begin(), nan.begin() + static_cast<long>(stair_at), '\n'));
   EXPECT_NE(e.find("labels.yaml:" + std::to_string(nan_line) + ":"), std::string::npos) << e;
   // A scale in place of a rotation, and .inf in a length.
   std::string scaled = original;
@@ -266,7 +273,8 @@ TEST(HostileFiles, FifosAndDevicesInPlaceOfDatasetFilesAreRefusedAtOnce) {
 TEST(HostileOni, RecordsOpenNI2sPlayerWouldTrustAreRefusedBeforeItSeesThem) {
   // Found by tests/fuzz/fuzz_oni: a property record's name and the next record's header
   // overwritten; OpenNI2's player read past its buffers and crashed (exit 139 from the daemon).
-  const std::string known = std::string(STAIRGUIDE_SOURCE_DIR) + "/tests/fuzz/corpus/oni/crash-player-property.oni";
+  const std::string known =
+      std::string(STAIRGUIDE_SOURCE_DIR) + "/tests/fuzz/corpus/oni/crash-player-property.oni";
   std::string e = error_of([&] { OniSource s(known); });
   EXPECT_NE(e.find("crash-player-property.oni: corrupt recording (record at byte 736: name not a string)"),
             std::string::npos)

@@ -76,7 +76,8 @@ TEST(CliHostile, BrokenEnvConfigDoesNotStopACommandGivenItsFileOrNeedingNone) {
 
 TEST(CliHostile, EmptyFileArgumentsAreUsageErrors) {
   // `--check-config ""` and `--replay ""` started the live camera path (and waited for one).
-  for (const char* args : {"--check-config ''", "--replay ''", "--config '' --replay synth:ascending_static:1"}) {
+  for (const char* args :
+       {"--check-config ''", "--replay ''", "--config '' --replay synth:ascending_static:1"}) {
     const CliRun r = run_shell(daemon(args));
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_NE(r.out.find("needs a non-empty value"), std::string::npos) << args << ": " << r.out;

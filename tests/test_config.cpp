@@ -181,12 +181,14 @@ TEST(Config, DuplicateKeyIsRefusedWithBothLines) {
   EXPECT_NE(e.find("test_config_dup.yaml:4"), std::string::npos) << e;
   EXPECT_NE(e.find("key 'segmentation.voxel_size_cm'"), std::string::npos) << e;
   EXPECT_NE(e.find("given twice (first on line 2)"), std::string::npos) << e;
-  const std::string s = error_of("dup_section", "floor:\n  tilt_min_deg: 20\nodometry:\n  iterations: 5\nfloor:\n"
-                                                "  tilt_max_deg: 60\n");
+  const std::string s = error_of("dup_section",
+                                 "floor:\n  tilt_min_deg: 20\nodometry:\n  iterations: 5\nfloor:\n"
+                                 "  tilt_max_deg: 60\n");
   EXPECT_NE(s.find("test_config_dup_section.yaml:5"), std::string::npos) << s;
   EXPECT_NE(s.find("key 'floor' given twice (first on line 1)"), std::string::npos) << s;
   // The same key in two sections is no duplicate.
-  EXPECT_NO_THROW(load_config_text("floor:\n  min_area_m2: 0.3\nmanhattan:\n  min_area_m2: 0.05\n", "ok.yaml"));
+  EXPECT_NO_THROW(
+      load_config_text("floor:\n  min_area_m2: 0.3\nmanhattan:\n  min_area_m2: 0.05\n", "ok.yaml"));
 }
 
 TEST(Config, SecondDocumentIsRefused) {
@@ -240,7 +242,8 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
     const char* what;
   };
   const Case cases[] = {
-      {"floor:\n  ambiguous_rise_min_cm: 30\n  ambiguous_rise_max_cm: 20\n", ":3: key 'floor.ambiguous_rise_max_cm'",
+      {"floor:\n  ambiguous_rise_min_cm: 30\n  ambiguous_rise_max_cm: 20\n",
+       ":3: key 'floor.ambiguous_rise_max_cm'",
        "floor.ambiguous_rise_min_cm must not exceed floor.ambiguous_rise_max_cm"},
       {"floor:\n  curb_rise_max_cm: 4\n  curb_rise_min_cm: 8\n", ":3: key 'floor.curb_rise_min_cm'",
        "floor.curb_rise_min_cm must not exceed floor.curb_rise_max_cm"},

@@ -112,7 +112,8 @@ class Child {
     pollfd p{fd_, POLLIN, 0};
     if (poll(&p, 1, ms) <= 0) return;
     char b[4096];
-    for (ssize_t k; (k = recv(fd_, b, sizeof b, MSG_DONTWAIT)) > 0;) notes_.emplace_back(b, static_cast<std::size_t>(k));
+    for (ssize_t k; (k = recv(fd_, b, sizeof b, MSG_DONTWAIT)) > 0;)
+      notes_.emplace_back(b, static_cast<std::size_t>(k));
   }
   int fd_ = -1;
   pid_t pid_ = -1;
@@ -147,7 +148,8 @@ TEST(DaemonStart, SigtermInTheFirstMillisecondsIsACleanStop) {
   // A unit stopped right after it was started: SIGTERM while the ~190 shared libraries load
   // killed the process (exit 143).
   for (const int delay_ms : {5, 10, 30, 60, 150}) {
-    Child d({"--config", kShipped, "--replay", "synth:ascending_static:1000", "--realtime", "--no-frame-lines"});
+    Child d(
+        {"--config", kShipped, "--replay", "synth:ascending_static:1000", "--realtime", "--no-frame-lines"});
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
     d.send(SIGTERM);
     EXPECT_EQ(d.wait_exit(20), 0) << "SIGTERM " << delay_ms << " ms after exec";

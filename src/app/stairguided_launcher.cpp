@@ -29,8 +29,8 @@ void block_stop_signals(int, char**, char**) {
   sigprocmask(SIG_BLOCK, &sigs, nullptr);
 }
 // Before main and the C++ runtime's constructors.
-__attribute__((section(".preinit_array"), used)) void (*const block_early)(int, char**, char**) =
-    block_stop_signals;
+__attribute__((section(".preinit_array"), used)) void (*const block_early)(int, char**,
+                                                                           char**) = block_stop_signals;
 
 }  // namespace
 

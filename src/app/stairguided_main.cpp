@@ -114,8 +114,8 @@ void block_stop_signals(int, char**, char**) {
   sigaddset(&sigs, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
 }
-__attribute__((section(".preinit_array"), used)) void (*const block_stop_signals_early)(int, char**, char**) =
-    block_stop_signals;
+__attribute__((section(".preinit_array"),
+               used)) void (*const block_stop_signals_early)(int, char**, char**) = block_stop_signals;
 
 }  // namespace
 

@@ -148,14 +148,16 @@ std::vector<TimedPose> read_groundtruth(const std::string& path) {
       throw SourceError(at + "timestamp " + tok[0] + " is out of range [-1e10, 1e10] s");
     for (int i = 1; i <= 3; ++i)
       if (std::abs(v[i]) > 1e5)
-        throw SourceError(at + "translation " + tok[i] + " m is out of range [-1e5, 1e5] (not a camera pose)");
+        throw SourceError(at + "translation " + tok[i] +
+                          " m is out of range [-1e5, 1e5] (not a camera pose)");
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     for (int i = 4; i <= 7; ++i)
       if (std::abs(v[i]) > 2.0)
         throw SourceError(at + "quaternion component " + tok[i] + " is not that of a unit quaternion");
     if (!(q.norm() > 1e-6)) throw SourceError(at + "zero quaternion");
     if (std::abs(q.norm() - 1.0) > 0.01)
-      throw SourceError(at + "quaternion of norm " + fmt_num(q.norm()) + " (a rotation is a unit quaternion)");
+      throw SourceError(at + "quaternion of norm " + fmt_num(q.norm()) +
+                        " (a rotation is a unit quaternion)");
     q.normalize();
     TimedPose p;
     p.timestamp = v[0];

@@ -104,7 +104,8 @@ class MapReader {
     // A rigid transform: a rotation (orthonormal, det +1; written with 9 digits, off by 1e-6 at
     // most) and a translation no recording could span.
     const Eigen::Matrix3f r = m.topLeftCorner<3, 3>();
-    if ((r.transpose() * r - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() > 1e-3f || r.determinant() < 0.f)
+    if ((r.transpose() * r - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() > 1e-3f ||
+        r.determinant() < 0.f)
       throw err(v, what_ + ": key '" + key + "' is not a rigid transform (its 3x3 part is not a rotation)");
     if (m.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > 1e5f)
       throw err(v, what_ + ": key '" + key + "' translation is beyond 100 km");

@@ -1,10 +1,10 @@
 // .oni replay through OpenNI2's own player (see DESIGN.md for the checked facts this relies on).
-#include <chrono>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <thread>
@@ -40,11 +40,12 @@ void check_oni_records(const std::string& path, std::uintmax_t size) {
   // file asked for 6 GB); a recording holds a depth and a colour stream, a few more at most.
   // Every version's 24-byte file header ends with that count.
   if (le32(h + 20) > 64)
-    throw SourceError("oni " + path + ": corrupt recording (the file header announces " + std::to_string(le32(h + 20)) +
-                      " streams)");
+    throw SourceError("oni " + path + ": corrupt recording (the file header announces " +
+                      std::to_string(le32(h + 20)) + " streams)");
   if (!(h[4] == 1 && h[5] == 0 && (h[6] | h[7] << 8) >= 1)) return;
   auto bad = [&](std::uintmax_t at, const std::string& why) {
-    return SourceError("oni " + path + ": corrupt recording (record at byte " + std::to_string(at) + ": " + why + ")");
+    return SourceError("oni " + path + ": corrupt recording (record at byte " + std::to_string(at) + ": " +
+                       why + ")");
   };
   std::uintmax_t pos = 24;
   std::set<std::uint32_t> cropped;  // streams (node ids) with their xnCropping property
@@ -78,7 +79,8 @@ void check_oni_records(const std::string& path, std::uintmax_t size) {
         if (36ull + len > fields || !in.read(reinterpret_cast<char*>(v), 4)) throw bad(pos, "no value size");
         const std::uint32_t vsize = le32(v);
         if (36ull + len + vsize != fields) throw bad(pos, "value of " + std::to_string(vsize) + " bytes");
-        if ((type == 0x03 || type == 0x04) && vsize != 8) throw bad(pos, "number of " + std::to_string(vsize) + " bytes");
+        if ((type == 0x03 || type == 0x04) && vsize != 8)
+          throw bad(pos, "number of " + std::to_string(vsize) + " bytes");
       }
     }
     // A stream the player serves without its cropping state crashed it once its frames came
@@ -213,7 +215,7 @@ ReadResult OniSource::read(RgbdFrame& out) {
   if (!m.read_one(m.depth, m.depth_ref, timeout_ms, why)) {
     m.ended = true;
     return {ReadStatus::kError, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
-                                  " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
+                                    " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
   }
   if (!depth_frame_to_metres(m.depth_ref, out.depth)) {
     m.ended = true;

@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -111,8 +111,8 @@ void check_pcd_header(const std::string& path) {
     if (key.empty() || key[0] == '#') continue;
     // PCL matches header keys by their first letters: a line "VIrmat" (found by fuzzing) left
     // its parse half done and crashed it. Only the keys of the format pass.
-    static const char* const kKeys[] = {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT",
-                                        "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+    static const char* const kKeys[] = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                                        "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
     if (std::none_of(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }))
       throw SourceError(path + ": corrupt PCD header (unknown line '" + key.substr(0, 40) + "')");
     auto& values = h[key];
@@ -150,8 +150,8 @@ void check_pcd_header(const std::string& path) {
     const long long count = h["COUNT"].empty() ? 1 : number(h["COUNT"][i], "COUNT");
     const std::string& type = h["TYPE"][i];
     if (size != 1 && size != 2 && size != 4 && size != 8)
-      throw SourceError(path + ": corrupt PCD header (field '" + fields[i] + "' SIZE " + std::to_string(size) +
-                        "; 1, 2, 4 or 8 expected)");
+      throw SourceError(path + ": corrupt PCD header (field '" + fields[i] + "' SIZE " +
+                        std::to_string(size) + "; 1, 2, 4 or 8 expected)");
     if (type != "I" && type != "U" && type != "F")
       throw SourceError(path + ": corrupt PCD header (field '" + fields[i] + "' TYPE '" + type +
                         "'; I, U or F expected)");
@@ -206,13 +206,15 @@ void check_pcd_header(const std::string& path) {
                         " bytes uncompressed, the header's " + std::to_string(points) + " points of " +
                         std::to_string(point_size) + " bytes are " + std::to_string(data_bytes) + ")");
     if (compressed <= 0 || compressed > body - 8)
-      throw SourceError(path + ": truncated or corrupt PCD (compressed body of " + std::to_string(compressed) +
-                        " bytes, the file holds " + std::to_string(body - 8) + " after the header)");
+      throw SourceError(path + ": truncated or corrupt PCD (compressed body of " +
+                        std::to_string(compressed) + " bytes, the file holds " + std::to_string(body - 8) +
+                        " after the header)");
   } else if (data == "ascii") {
     // Every value is at least one character and a separator.
     if (body < 2 * points * values - 1)
-      throw SourceError(path + ": truncated PCD (ascii data of " + std::to_string(body) + " bytes cannot hold " +
-                        std::to_string(points) + " points of " + std::to_string(values) + " values)");
+      throw SourceError(path + ": truncated PCD (ascii data of " + std::to_string(body) +
+                        " bytes cannot hold " + std::to_string(points) + " points of " +
+                        std::to_string(values) + " values)");
   } else {
     throw SourceError(path + ": unknown PCD DATA kind '" + data + "'");
   }

@@ -1,5 +1,6 @@
 #include "stairguide/config/config_loader.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -9,7 +10,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <sys/stat.h>
 #include <type_traits>
 
 #include "stairguide/config/strict_yaml.hpp"
@@ -253,7 +253,8 @@ constexpr YamlLimits kConfigYamlLimits{20000, 8};
 
 PipelineConfig load_config_text(const std::string& text, const std::string& name, ConfigLoadReport* report) {
   if (text.size() > kMaxConfigBytes)
-    throw ConfigError(name + ": config is bigger than " + std::to_string(kMaxConfigBytes) + " bytes; refused");
+    throw ConfigError(name + ": config is bigger than " + std::to_string(kMaxConfigBytes) +
+                      " bytes; refused");
   YAML::Node doc;
   try {
     doc = load_strict_yaml(text, name, kConfigYamlLimits);

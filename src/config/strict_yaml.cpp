@@ -27,12 +27,13 @@ std::string read_small_file(const std::string& path, std::size_t max_bytes, cons
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw InputFileError(path + ": cannot stat " + what + " (" + std::strerror(errno) + ")");
+  if (::fstat(fd, &st) != 0)
+    throw InputFileError(path + ": cannot stat " + what + " (" + std::strerror(errno) + ")");
   if (S_ISDIR(st.st_mode)) throw InputFileError(path + ": is a directory, not a " + what);
   if (!S_ISREG(st.st_mode)) {
-    const char* kind = S_ISFIFO(st.st_mode)  ? "a FIFO"
-                       : S_ISCHR(st.st_mode) ? "a character device"
-                       : S_ISBLK(st.st_mode) ? "a block device"
+    const char* kind = S_ISFIFO(st.st_mode)   ? "a FIFO"
+                       : S_ISCHR(st.st_mode)  ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
                        : S_ISSOCK(st.st_mode) ? "a socket"
                                               : "not a regular file";
     throw InputFileError(path + ": " + what + " is " + kind + ", not a regular file; refused");
@@ -80,7 +81,8 @@ class Checker : public YAML::EventHandler {
 
   void OnDocumentStart(const YAML::Mark& mark) override {
     if (++documents_ > 1)
-      throw Refusal{mark.line, "a second YAML document ('---' or '...' followed by more); one document expected"};
+      throw Refusal{mark.line,
+                    "a second YAML document ('---' or '...' followed by more); one document expected"};
   }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t) override {
@@ -92,14 +94,17 @@ class Checker : public YAML::EventHandler {
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
     throw Refusal{mark.line, "YAML aliases (*name) are not accepted here"};
   }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string& value) override {
     leaf(mark, value);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
     open(mark, false);
   }
   void OnSequenceEnd() override { close(); }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
     open(mark, true);
   }
   void OnMapEnd() override { close(); }
@@ -140,8 +145,8 @@ class Checker : public YAML::EventHandler {
     if (it != f.seen.end()) {
       f.key = k;
       f.want_key = false;
-      throw Refusal{mark.line, "key '" + path() + "' given twice (first on line " + std::to_string(it->second + 1) +
-                                   "): the later value would be ignored"};
+      throw Refusal{mark.line, "key '" + path() + "' given twice (first on line " +
+                                   std::to_string(it->second + 1) + "): the later value would be ignored"};
     }
     f.seen.emplace(k, mark.line);
     f.key = k;
@@ -167,9 +172,11 @@ class Checker : public YAML::EventHandler {
   void open(const YAML::Mark& mark, bool map) {
     count(mark);
     if (!stack_.empty() && stack_.back().map && stack_.back().want_key)
-      throw Refusal{mark.line, "a mapping key must be a plain value (found a collection) under '" + path() + "'"};
+      throw Refusal{mark.line,
+                    "a mapping key must be a plain value (found a collection) under '" + path() + "'"};
     if (static_cast<int>(stack_.size()) >= limits_.max_depth)
-      throw Refusal{mark.line, "nested deeper than " + std::to_string(limits_.max_depth) + " levels; refused"};
+      throw Refusal{mark.line,
+                    "nested deeper than " + std::to_string(limits_.max_depth) + " levels; refused"};
     stack_.emplace_back();
     stack_.back().map = map;
   }

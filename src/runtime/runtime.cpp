@@ -712,7 +712,8 @@ struct Runtime::Impl {
         std::lock_guard<std::mutex> lk(stats_mutex);
         ever = have_first;
       }
-      notify(std::string(ever ? "STATUS=camera lost: " : "STATUS=waiting for camera: ") + why + "; reconnecting");
+      notify(std::string(ever ? "STATUS=camera lost: " : "STATUS=waiting for camera: ") + why +
+             "; reconnecting");
     } else {
       feedback->camera_back();
     }
@@ -873,7 +874,8 @@ void Runtime::start() {
   // READY=1 once the config is loaded, the replay opened and the threads are up, not after the
   // first frame: without a camera plugged in that would never come, and `systemctl start`
   // would wait for it. STATUS says what the daemon waits for.
-  const std::string ready = "READY=1\nSTATUS=" + (m.live ? "waiting for camera " + m.opt.input : "replaying " + m.source->describe());
+  const std::string ready = "READY=1\nSTATUS=" + (m.live ? "waiting for camera " + m.opt.input
+                                                         : "replaying " + m.source->describe());
   if (m.opt.synchronous) {
     m.notify(ready);
     return;
