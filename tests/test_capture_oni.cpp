@@ -82,7 +82,7 @@ TEST(Oni, FullSizeDepthOnlyRecording) {
   EXPECT_EQ(src.read(f).status, ReadStatus::kEnd);
 }
 
-TEST(Oni, TruncatedRecordingEndsCleanlyEarly) {
+TEST(Oni, TruncatedRecordingIsAnErrorAfterTheFramesItHolds) {
   const fs::path full = scratch("full.oni"), cut = scratch("truncated.oni");
   const int n = 10, w = 80, h = 60;
   const auto frames = make_frames(n, w, h, 5);
@@ -103,7 +103,8 @@ TEST(Oni, TruncatedRecordingEndsCleanlyEarly) {
     ++got;
     ASSERT_LT(got, n);
   }
-  EXPECT_EQ(r.status, ReadStatus::kEnd);
+  // Not an end: every consumer (odometry, eval, the daemon's replay) must fail on it, not exit 0.
+  EXPECT_EQ(r.status, ReadStatus::kError);
   EXPECT_GE(got, 3);
   EXPECT_LE(got, 5);
   EXPECT_NE(r.message.find("truncated.oni"), std::string::npos) << r.message;

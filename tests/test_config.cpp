@@ -1,7 +1,9 @@
 // Config loader: the shipped file, and each kind of invalid input with file, line and key.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <string>
 
@@ -201,4 +203,101 @@ TEST(Config, YamlSyntaxErrorHasLine) {
 TEST(Config, EmptyFileGivesDefaults) {
   const PipelineConfig c = load_config(write_tmp("empty", "# nothing\n"));
   EXPECT_TRUE(config_equal(c, PipelineConfig{}));
+}
+
+// ---- issue 35: hostile config files ----
+
+TEST(Config, DuplicateKeyIsRefusedWithBothLines) {
+  // yaml-cpp keeps the first value and drops the later one unseen: `0` was never validated.
+  const std::string e =
+      error_of("dup", "segmentation:\n  voxel_size_cm: 3\n  normal_radius_cm: 5\n  voxel_size_cm: 0\n");
+  EXPECT_NE(e.find("test_config_dup.yaml:4"), std::string::npos) << e;
+  EXPECT_NE(e.find("key 'segmentation.voxel_size_cm'"), std::string::npos) << e;
+  EXPECT_NE(e.find("given twice (first on line 2)"), std::string::npos) << e;
+  const std::string s = error_of("dup_section",
+                                 "floor:\n  tilt_min_deg: 20\nodometry:\n  iterations: 5\nfloor:\n"
+                                 "  tilt_max_deg: 60\n");
+  EXPECT_NE(s.find("test_config_dup_section.yaml:5"), std::string::npos) << s;
+  EXPECT_NE(s.find("key 'floor' given twice (first on line 1)"), std::string::npos) << s;
+  // The same key in two sections is no duplicate.
+  EXPECT_NO_THROW(
+      load_config_text("floor:\n  min_area_m2: 0.3\nmanhattan:\n  min_area_m2: 0.05\n", "ok.yaml"));
+}
+
+TEST(Config, SecondDocumentIsRefused) {
+  const std::string e = error_of("docs", "floor:\n  tilt_min_deg: 20\n---\nfloor:\n  tilt_min_deg: 0\n");
+  EXPECT_NE(e.find("test_config_docs.yaml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("second YAML document"), std::string::npos) << e;
+}
+
+TEST(Config, HugeOrSpecialFilesAreRefusedWithoutReadingThem) {
+  // 5 MB of a flow list: refused by size before yaml-cpp sees it (it took 1.3 GB to parse).
+  std::string big = "floor:\n  tilt_min_deg: [";
+  while (big.size() < 5u << 20) big += "0,0,0,0,0,0,0,0,";
+  big += "0]\n";
+  std::string e = error_of("big", big);
+  EXPECT_NE(e.find("test_config_big.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("bigger than 1048576 bytes"), std::string::npos) << e;
+  // Under the size limit, a list of 200000 items is still far more nodes than a config holds.
+  std::string many = "floor:\n  tilt_min_deg: [";
+  for (int i = 0; i < 200000; ++i) many += "0,";
+  many += "0]\n";
+  e = error_of("many", many);
+  EXPECT_NE(e.find("test_config_many.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("more than 20000 YAML nodes"), std::string::npos) << e;
+  // Deep nesting.
+  e = error_of("deep", "floor: " + std::string(100, '[') + std::string(100, ']') + "\n");
+  EXPECT_NE(e.find("nested deeper than 8"), std::string::npos) << e;
+  // /dev/zero never ends; a FIFO with no writer blocks a plain read forever.
+  try {
+    load_config("/dev/zero");
+    ADD_FAILURE() << "/dev/zero accepted";
+  } catch (const ConfigError& x) {
+    EXPECT_NE(std::string(x.what()).find("/dev/zero: config file is a character device"), std::string::npos)
+        << x.what();
+  }
+  const std::string fifo = std::string(STAIRGUIDE_BINARY_DIR) + "/test_config_fifo.yaml";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    load_config(fifo);
+    ADD_FAILURE() << "FIFO accepted";
+  } catch (const ConfigError& x) {
+    EXPECT_NE(std::string(x.what()).find(fifo + ": config file is a FIFO"), std::string::npos) << x.what();
+  }
+  std::remove(fifo.c_str());
+}
+
+TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
+  struct Case {
+    const char* text;
+    const char* later;  // "FILE:LINE: key 'K'" of the later key
+    const char* what;
+  };
+  const Case cases[] = {
+      {"floor:\n  ambiguous_rise_min_cm: 30\n  ambiguous_rise_max_cm: 20\n",
+       ":3: key 'floor.ambiguous_rise_max_cm'",
+       "floor.ambiguous_rise_min_cm must not exceed floor.ambiguous_rise_max_cm"},
+      {"floor:\n  curb_rise_max_cm: 4\n  curb_rise_min_cm: 8\n", ":3: key 'floor.curb_rise_min_cm'",
+       "floor.curb_rise_min_cm must not exceed floor.curb_rise_max_cm"},
+      {"stair_detection:\n  floorless_tilt_min_deg: 50\n  floorless_tilt_max_deg: 40\n",
+       ":3: key 'stair_detection.floorless_tilt_max_deg'",
+       "stair_detection.floorless_tilt_min_deg must not exceed stair_detection.floorless_tilt_max_deg"},
+      // Only one of the pair given: named at it.
+      {"# x\n\ncapture:\n  min_range_m: 2\n  max_range_m: 2\n", ":5: key 'capture.max_range_m'",
+       "capture.min_range_m must be below capture.max_range_m"},
+      {"floor:\n  height_min_m: 1.5\n  height_max_m: 1.2\n", ":3: key 'floor.height_max_m'",
+       "floor.height_min_m must not exceed floor.height_max_m"},
+      {"manhattan:\n  riser_going_min_cm: 70\n", ":2: key 'manhattan.riser_going_min_cm'",
+       "manhattan.riser_going_min_cm must not exceed manhattan.riser_going_max_cm"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const std::string name = "pair" + std::to_string(i++);
+    const std::string e = error_of(name, c.text);
+    EXPECT_NE(e.find("test_config_" + name + ".yaml" + c.later), std::string::npos) << e;
+    EXPECT_NE(e.find(c.what), std::string::npos) << e;
+  }
+  // Equal bounds stay allowed where they mean something (a single accepted value).
+  EXPECT_NO_THROW(load_config_text("floor:\n  curb_rise_min_cm: 10\n  curb_rise_max_cm: 10\n", "eq.yaml"));
 }

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "cli/command.hpp"
 #include "stairguide/config/config_loader.hpp"
@@ -77,6 +78,18 @@ void print_help(std::FILE* out) {
                     "/etc/stairguide/stairguide.yaml, then the source tree's config/stairguide.yaml).\n");
 }
 
+/// False for a command that is given its file (check-config FILE) or needs no config (synth
+/// --list, dump-config --defaults): the default config ($STAIRGUIDE_CONFIG, ...) is not loaded
+/// for it, so a broken one cannot stop it. A file named with --config is always loaded.
+bool needs_default_config(const std::string& name, const std::vector<std::string>& args) {
+  auto has = [&](const char* a) { return std::find(args.begin(), args.end(), a) != args.end(); };
+  if (name == "check-config")
+    return std::none_of(args.begin(), args.end(), [](const std::string& a) { return a.rfind("--", 0) != 0; });
+  if (name == "synth") return !has("--list");
+  if (name == "dump-config") return !has("--defaults");
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,7 +115,8 @@ int main(int argc, char** argv) {
       std::printf("usage: stairguide %s\n%s\n", cmd->usage, cmd->summary);
       return 0;
     }
-    ctx.config_path = cfg ? *cfg : default_config_path();
+    if (cfg && cfg->empty()) throw cli::UsageError("--config needs a file name, got an empty one");
+    ctx.config_path = cfg ? *cfg : needs_default_config(name, ctx.args) ? default_config_path() : "";
     if (!ctx.config_path.empty()) ctx.config = load_config(ctx.config_path);
     try {
       return cmd->fn(ctx);

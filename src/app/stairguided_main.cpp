@@ -74,6 +74,11 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
         return false;
       }
       out = argv[++i];
+      // An empty FILE would read as "not given" below: `--replay ""` started the live camera.
+      if (out.empty()) {
+        err = s + " needs a non-empty value";
+        return false;
+      }
       return true;
     };
     if (s == "--config") {
@@ -113,6 +118,22 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
   }
   return true;
 }
+
+// `stairguided` is a static launcher (stairguided_launcher.cpp) that blocks the stop and reload
+// signals and execs this binary: the mask survives the exec, so a SIGTERM sent while the ~190
+// shared libraries load waits for the signal thread instead of killing the process (exit 143).
+// Run directly, this binary blocks them from its .preinit_array, before the libraries'
+// constructors though after the dynamic loader's relocations (most of the start-up).
+void block_stop_signals(int, char**, char**) {
+  sigset_t sigs;
+  sigemptyset(&sigs);
+  sigaddset(&sigs, SIGTERM);
+  sigaddset(&sigs, SIGINT);
+  sigaddset(&sigs, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
+}
+__attribute__((section(".preinit_array"),
+               used)) void (*const block_stop_signals_early)(int, char**, char**) = block_stop_signals;
 
 }  // namespace
 

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "capture_util.hpp"
+#include "stairguide/config/strict_yaml.hpp"
 
 namespace fs = std::filesystem;
 
@@ -29,9 +30,10 @@ DatasetCamera read_camera_yaml(const std::string& path) {
     throw SourceError(path + ": " + (fs::exists(path, ec) ? "not a regular file" : "missing (no such file)"));
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw SourceError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    // Seven numbers and comments: 64 KiB and 1000 nodes are far more than one holds.
+    root = load_strict_yaml(read_small_file(path, 64 * 1024, "camera.yaml"), path, YamlLimits{1000, 4});
+  } catch (const InputFileError& e) {
+    throw SourceError(e.what());
   }
   if (!root.IsMap()) throw SourceError(path + ": expected a mapping of fx fy cx cy width height depth_scale");
   auto get = [&](const char* key, double lo, double hi) {
@@ -86,10 +88,21 @@ struct ListEntry {
   std::string path;
 };
 
+// depth.txt, rgb.txt and groundtruth.txt: a line per frame (about 40-80 bytes); 256 MiB is
+// millions of frames, hours at 30 Hz. A FIFO or a device is refused, never read.
+constexpr std::size_t kMaxListBytes = 256u << 20;
+
+std::string read_text(const std::string& file) {
+  try {
+    return read_small_file(file, kMaxListBytes, "list file");
+  } catch (const InputFileError& e) {
+    throw SourceError(e.what());
+  }
+}
+
 // "timestamp path" lines, '#' comments and blank lines skipped.
 std::vector<ListEntry> read_list(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw SourceError(file + ": cannot open (" + std::strerror(errno) + ")");
+  std::istringstream in(read_text(file));
   std::vector<ListEntry> out;
   std::string line;
   int n = 0;
@@ -112,8 +125,7 @@ std::vector<ListEntry> read_list(const std::string& file) {
 }  // namespace
 
 std::vector<TimedPose> read_groundtruth(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw SourceError(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::istringstream in(read_text(path));
   std::vector<TimedPose> out;
   std::string line;
   int n = 0;
@@ -129,8 +141,23 @@ std::vector<TimedPose> read_groundtruth(const std::string& path) {
     if (!ok || (ss >> extra))
       throw SourceError(path + ":" + std::to_string(n) +
                         ": expected 'timestamp tx ty tz qx qy qz qw', got '" + t + "'");
+    // Finite is not enough: tx = 1e300 reads as a number, becomes inf in float and the ATE NaN.
+    // No recording spans more than 100 km, and a TUM quaternion is written as a unit one.
+    const std::string at = path + ":" + std::to_string(n) + ": ";
+    if (std::abs(v[0]) > 1e10)
+      throw SourceError(at + "timestamp " + tok[0] + " is out of range [-1e10, 1e10] s");
+    for (int i = 1; i <= 3; ++i)
+      if (std::abs(v[i]) > 1e5)
+        throw SourceError(at + "translation " + tok[i] +
+                          " m is out of range [-1e5, 1e5] (not a camera pose)");
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (!(q.norm() > 1e-6)) throw SourceError(path + ":" + std::to_string(n) + ": zero quaternion");
+    for (int i = 4; i <= 7; ++i)
+      if (std::abs(v[i]) > 2.0)
+        throw SourceError(at + "quaternion component " + tok[i] + " is not that of a unit quaternion");
+    if (!(q.norm() > 1e-6)) throw SourceError(at + "zero quaternion");
+    if (std::abs(q.norm() - 1.0) > 0.01)
+      throw SourceError(at + "quaternion of norm " + fmt_num(q.norm()) +
+                        " (a rotation is a unit quaternion)");
     q.normalize();
     TimedPose p;
     p.timestamp = v[0];

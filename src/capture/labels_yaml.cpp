@@ -3,13 +3,16 @@
 // every key present, no unknown key, so that a mislabelled file never passes silently.
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "capture_util.hpp"
 #include "stairguide/capture/dataset.hpp"
+#include "stairguide/config/strict_yaml.hpp"
 
 namespace stairguide {
 namespace {
@@ -66,13 +69,20 @@ class MapReader {
   template <class T>
   T scalar(const char* key) {
     YAML::Node v = get(key);
+    T out{};
     try {
       if (!v.IsScalar()) throw YAML::Exception(v.Mark(), "not a scalar");
-      return v.as<T>();
+      out = v.as<T>();
     } catch (const YAML::Exception&) {
       throw err(v, what_ + ": key '" + key + "' has the wrong type ('" +
                        (v.IsScalar() ? v.Scalar() : "(not a scalar)") + "')");
     }
+    if constexpr (std::is_floating_point_v<T>) {
+      // .nan and .inf read as numbers; no label is either, and 1e30 m is no label either.
+      if (!std::isfinite(out) || std::abs(out) > static_cast<T>(1e10))
+        throw err(v, what_ + ": key '" + key + "' must be a finite number, got '" + v.Scalar() + "'");
+    }
+    return out;
   }
   Pose pose(const char* key) {
     YAML::Node v = get(key);
@@ -86,9 +96,19 @@ class MapReader {
         throw err(v, what_ + ": key '" + key + "' element " + std::to_string(i) + " is not a number");
       }
     }
+    if (!m.allFinite())
+      throw err(v, what_ + ": key '" + key + "' holds a number that is not finite (nan or inf)");
     if (std::abs(m(3, 0)) > 1e-6f || std::abs(m(3, 1)) > 1e-6f || std::abs(m(3, 2)) > 1e-6f ||
         std::abs(m(3, 3) - 1.f) > 1e-6f)
       throw err(v, what_ + ": key '" + key + "' last row must be 0 0 0 1");
+    // A rigid transform: a rotation (orthonormal, det +1; written with 9 digits, off by 1e-6 at
+    // most) and a translation no recording could span.
+    const Eigen::Matrix3f r = m.topLeftCorner<3, 3>();
+    if ((r.transpose() * r - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() > 1e-3f ||
+        r.determinant() < 0.f)
+      throw err(v, what_ + ": key '" + key + "' is not a rigid transform (its 3x3 part is not a rotation)");
+    if (m.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > 1e5f)
+      throw err(v, what_ + ": key '" + key + "' translation is beyond 100 km");
     Pose p;
     p.matrix() = m;
     return p;
@@ -172,9 +192,11 @@ std::vector<FrameTruth> read_labels_yaml(const std::string& path) {
     throw SourceError(path + ": missing or not a regular file");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw SourceError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    // A labelled frame is about 1.2 kB and 130 nodes: these bounds are some 15000 frames with a
+    // staircase each, and keep yaml-cpp's tree (a few hundred bytes a node) under a gigabyte.
+    root = load_strict_yaml(read_small_file(path, 64u << 20, "labels.yaml"), path, YamlLimits{2000000, 8});
+  } catch (const InputFileError& e) {
+    throw SourceError(e.what());
   }
   if (!root || root.IsNull()) throw SourceError(path + ": empty file");
   MapReader top(root, path, "labels");

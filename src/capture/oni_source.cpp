@@ -1,8 +1,12 @@
 // .oni replay through OpenNI2's own player (see DESIGN.md for the checked facts this relies on).
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <thread>
 
 #include "capture_util.hpp"
@@ -12,6 +16,83 @@
 namespace fs = std::filesystem;
 
 namespace stairguide {
+namespace {
+
+std::uint32_t le32(const unsigned char* b) {
+  return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
+         static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
+}
+
+// Walks the container's records before OpenNI2's player sees them. The player trusts every
+// size it reads: a record whose header was overwritten (found by tests/fuzz/fuzz_oni) made it
+// read far past its buffers and crash the process. Each record must carry the "NIR\0"
+// signature and a known type, its header sizes must be sane, and a property's or a stream's
+// name must lie inside its record. A record cut by the end of the file ends the walk (a
+// truncated recording plays its whole frames and then reports the end as an error). Only the
+// layout of 1.0.1 and later (28-byte record headers: OpenNI2's Recorder and OniWriter) is
+// walked; a file without the NI10 signature is left to the player to refuse.
+void check_oni_records(const std::string& path, std::uintmax_t size) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char h[28];
+  if (!in.read(reinterpret_cast<char*>(h), 24)) return;
+  if (std::memcmp(h, "NI10", 4) != 0) return;
+  // The player allocates a table entry of some 2 kB per stream the header announces (a 50-byte
+  // file asked for 6 GB); a recording holds a depth and a colour stream, a few more at most.
+  // Every version's 24-byte file header ends with that count.
+  if (le32(h + 20) > 64)
+    throw SourceError("oni " + path + ": corrupt recording (the file header announces " +
+                      std::to_string(le32(h + 20)) + " streams)");
+  if (!(h[4] == 1 && h[5] == 0 && (h[6] | h[7] << 8) >= 1)) return;
+  auto bad = [&](std::uintmax_t at, const std::string& why) {
+    return SourceError("oni " + path + ": corrupt recording (record at byte " + std::to_string(at) + ": " +
+                       why + ")");
+  };
+  std::uintmax_t pos = 24;
+  std::set<std::uint32_t> cropped;  // streams (node ids) with their xnCropping property
+  while (size - pos >= 28) {
+    in.seekg(static_cast<std::streamoff>(pos));
+    if (!in.read(reinterpret_cast<char*>(h), 28)) return;
+    const std::uint32_t magic = le32(h), type = le32(h + 4), fields = le32(h + 12), payload = le32(h + 16);
+    if (magic != 0x0052494E) throw bad(pos, "no NIR signature");
+    if (type < 0x01 || type > 0x0E) throw bad(pos, "unknown type " + std::to_string(type));
+    if (fields < 28 || fields > (1u << 20)) throw bad(pos, "header size " + std::to_string(fields));
+    if (type != 0x0A && type != 0x0E && payload != 0) throw bad(pos, "a payload on a record that has none");
+    if (static_cast<std::uintmax_t>(fields) + payload > size - pos) return;  // cut by the end: truncated
+    const bool named = type == 0x02 || type == 0x03 || type == 0x04 || type == 0x05 || type == 0x06 ||
+                       type == 0x0C || type == 0x0D;
+    if (named) {
+      if (fields < 32) throw bad(pos, "no room for its name");
+      unsigned char l[4];
+      if (!in.read(reinterpret_cast<char*>(l), 4)) return;
+      const std::uint32_t len = le32(l);
+      if (len < 1 || len > 256 || 32ull + len > fields) throw bad(pos, "name length " + std::to_string(len));
+      std::string name(len, '\0');
+      if (!in.read(&name[0], len)) return;
+      if (name.back() != '\0' || name.find('\0') != len - 1) throw bad(pos, "name not a string");
+      name.pop_back();
+      for (char c : name)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != ' ' && c != '-' && c != '.')
+          throw bad(pos, "name not a string");
+      if (type == 0x06 && name == "xnCropping") cropped.insert(le32(h + 8));
+      if (type >= 0x03 && type <= 0x06) {  // properties: value size, then the value, filling the record
+        unsigned char v[4];
+        if (36ull + len > fields || !in.read(reinterpret_cast<char*>(v), 4)) throw bad(pos, "no value size");
+        const std::uint32_t vsize = le32(v);
+        if (36ull + len + vsize != fields) throw bad(pos, "value of " + std::to_string(vsize) + " bytes");
+        if ((type == 0x03 || type == 0x04) && vsize != 8)
+          throw bad(pos, "number of " + std::to_string(vsize) + " bytes");
+      }
+    }
+    // A stream the player serves without its cropping state crashed it once its frames came
+    // (fuzz_oni); OpenNI2's Recorder and OniWriter always write one before the stream is ready.
+    if (type == 0x09 && !cropped.count(le32(h + 8)))
+      throw bad(pos, "stream " + std::to_string(le32(h + 8)) + " has no xnCropping property");
+    pos += static_cast<std::uintmax_t>(fields) + payload;
+    if (type == 0x0B) return;  // End
+  }
+}
+
+}  // namespace
 
 struct OniSource::Impl {
   std::string path;
@@ -74,6 +155,7 @@ OniSource::OniSource(const std::string& path, const OniOptions& options) : impl_
   if (!fs::is_regular_file(path, ec)) throw SourceError("oni " + path + ": not a regular file");
   if (fs::file_size(path, ec) < 24)
     throw SourceError("oni " + path + ": too short to be a recording (truncated?)");
+  check_oni_records(path, fs::file_size(path, ec));
   const std::string init = ensure_openni();
   if (!init.empty()) throw SourceError("oni " + path + ": OpenNI2 unavailable: " + init);
   if (m.device.open(path.c_str()) != openni::STATUS_OK)
@@ -128,11 +210,12 @@ ReadResult OniSource::read(RgbdFrame& out) {
   const int timeout_ms = std::max(1, static_cast<int>(std::lround(m.options.frame_timeout * 1000.0)));
   std::string why;
   // A readFrame past the last frame blocks in manual mode, hence the frame count above; a
-  // recording shorter than it announces (truncated) shows as a wait that times out.
+  // recording shorter than it announces (truncated) shows as a wait that times out. That is an
+  // error, not an end: the frames it announced are missing (the ones before it were delivered).
   if (!m.read_one(m.depth, m.depth_ref, timeout_ms, why)) {
     m.ended = true;
-    return {ReadStatus::kEnd, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
-                                  " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
+    return {ReadStatus::kError, "oni " + m.path + ": recording ended early after " + std::to_string(m.next) +
+                                    " of " + std::to_string(m.depth_frames) + " frames (truncated?): " + why};
   }
   if (!depth_frame_to_metres(m.depth_ref, out.depth)) {
     m.ended = true;

@@ -5,9 +5,11 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -77,57 +79,143 @@ void fill_depth_and_intrinsics(const pcl::PointCloud<PointT>& cloud, RgbdFrame& 
   out.intrinsics = k;
 }
 
+// Bounds on a PCD frame. A depth camera's organized cloud is at most a few megapixels with a
+// few fields; these are far above that and far below what exhausts memory.
+constexpr long long kMaxPcdSide = 16384;               // WIDTH and HEIGHT
+constexpr long long kMaxPcdPoints = 4096LL * 4096LL;   // WIDTH x HEIGHT
+constexpr long long kMaxPcdCount = 1024;               // COUNT of one field (a descriptor's bins)
+constexpr long long kMaxPcdPointBytes = 16384;         // one point's record
+constexpr long long kMaxPcdDataBytes = 1LL << 30;      // the whole body, uncompressed
+constexpr std::size_t kMaxPcdHeaderBytes = 64 * 1024;  // everything up to and including DATA
+
 // Checks the PCD header ourselves before PCL reads the file: PCL 1.13's reader crashes on some
-// malformed files (a header without points), and our messages name the file and the problem.
+// malformed files (a header without points, a compressed body whose uncompressed size word is
+// 0), allocates whatever size the header claims, and its messages do not name the file. Every
+// size is bounded and checked against the file's own size here.
 void check_pcd_header(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SourceError(path + ": cannot open PCD file");
+  std::string head(kMaxPcdHeaderBytes, '\0');
+  in.read(&head[0], static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
   std::map<std::string, std::vector<std::string>> h;
-  std::string line;
-  std::streamoff header_end = 0;
-  for (int n = 0; n < 64 && std::getline(in, line); ++n) {
-    std::istringstream ss(line);
+  std::size_t pos = 0;
+  long long header_end = -1;
+  for (int n = 0; n < 64 && pos < head.size(); ++n) {
+    std::size_t eol = head.find('\n', pos);
+    if (eol == std::string::npos) break;  // a header line longer than what is left of 64 KiB
+    std::istringstream ss(head.substr(pos, eol - pos));
+    pos = eol + 1;
     std::string key, v;
     ss >> key;
     if (key.empty() || key[0] == '#') continue;
-    while (ss >> v) h[key].push_back(v);
+    // PCL matches header keys by their first letters: a line "VIrmat" (found by fuzzing) left
+    // its parse half done and crashed it. Only the keys of the format pass.
+    static const char* const kKeys[] = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                                        "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+    if (std::none_of(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }))
+      throw SourceError(path + ": corrupt PCD header (unknown line '" + key.substr(0, 40) + "')");
+    auto& values = h[key];
+    if (!values.empty()) throw SourceError(path + ": corrupt PCD header (" + key + " given twice)");
+    while (ss >> v) values.push_back(v);
     if (key == "DATA") {
-      header_end = in.tellg();
+      header_end = static_cast<long long>(pos);
       break;
     }
   }
   for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
     if (h[key].empty()) throw SourceError(path + ": not a PCD file (header has no " + key + " line)");
+  if (h.count("VIEWPOINT") && h["VIEWPOINT"].size() != 7)
+    throw SourceError(path + ": corrupt PCD header (VIEWPOINT needs 7 numbers)");
+  if (header_end < 0) throw SourceError(path + ": not a PCD file (no DATA line in the first 64 lines)");
   const auto& fields = h["FIELDS"];
   if (h["SIZE"].size() != fields.size() || h["TYPE"].size() != fields.size())
     throw SourceError(path + ": corrupt PCD header (FIELDS, SIZE and TYPE disagree)");
-  long width = 0, height = 0, points = 0, point_size = 0;
-  try {
-    width = std::stol(h["WIDTH"][0]);
-    height = std::stol(h["HEIGHT"][0]);
-    points = std::stol(h["POINTS"][0]);
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-      const long count = h["COUNT"].size() == fields.size() ? std::stol(h["COUNT"][i]) : 1;
-      point_size += std::stol(h["SIZE"][i]) * count;
+  if (!h["COUNT"].empty() && h["COUNT"].size() != fields.size())
+    throw SourceError(path + ": corrupt PCD header (FIELDS and COUNT disagree)");
+  auto number = [&](const std::string& text, const char* what) {
+    try {
+      std::size_t used = 0;
+      const long long v = std::stoll(text, &used);
+      if (used == text.size()) return v;
+    } catch (const std::exception&) {
     }
-  } catch (const std::exception&) {
-    throw SourceError(path + ": corrupt PCD header (WIDTH, HEIGHT, POINTS, SIZE or COUNT is not a number)");
+    throw SourceError(path + ": corrupt PCD header (" + what + " '" + text + "' is not a whole number)");
+  };
+  const long long width = number(h["WIDTH"][0], "WIDTH"), height = number(h["HEIGHT"][0], "HEIGHT");
+  const long long points = number(h["POINTS"][0], "POINTS");
+  long long point_size = 0, values = 0;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const long long size = number(h["SIZE"][i], "SIZE");
+    const long long count = h["COUNT"].empty() ? 1 : number(h["COUNT"][i], "COUNT");
+    const std::string& type = h["TYPE"][i];
+    if (size != 1 && size != 2 && size != 4 && size != 8)
+      throw SourceError(path + ": corrupt PCD header (field '" + fields[i] + "' SIZE " +
+                        std::to_string(size) + "; 1, 2, 4 or 8 expected)");
+    if (type != "I" && type != "U" && type != "F")
+      throw SourceError(path + ": corrupt PCD header (field '" + fields[i] + "' TYPE '" + type +
+                        "'; I, U or F expected)");
+    if (count < 1 || count > kMaxPcdCount)
+      throw SourceError(path + ": PCD field '" + fields[i] + "' COUNT " + std::to_string(count) +
+                        " is out of range [1, " + std::to_string(kMaxPcdCount) + "]");
+    point_size += size * count;
+    values += count;
   }
-  if (width <= 0 || height <= 0 || points != width * height)
+  if (width <= 0 || height <= 0 || width > kMaxPcdSide || height > kMaxPcdSide)
+    throw SourceError(path + ": PCD WIDTH " + std::to_string(width) + " x HEIGHT " + std::to_string(height) +
+                      " is out of range [1, " + std::to_string(kMaxPcdSide) + "] each");
+  if (points != width * height)
     throw SourceError(path + ": corrupt PCD header (WIDTH " + std::to_string(width) + " x HEIGHT " +
                       std::to_string(height) + " != POINTS " + std::to_string(points) + ")");
   if (height <= 1)
     throw SourceError(path + ": not an organized point cloud (height " + std::to_string(height) + ")");
+  if (points > kMaxPcdPoints)
+    throw SourceError(path + ": PCD of " + std::to_string(points) + " points is more than " +
+                      std::to_string(kMaxPcdPoints) + " (no depth camera gives that)");
+  if (point_size > kMaxPcdPointBytes)
+    throw SourceError(path + ": PCD point record of " + std::to_string(point_size) + " bytes is more than " +
+                      std::to_string(kMaxPcdPointBytes));
+  const long long data_bytes = points * point_size;
+  if (data_bytes > kMaxPcdDataBytes)
+    throw SourceError(path + ": PCD body of " + std::to_string(data_bytes) + " bytes is more than " +
+                      std::to_string(kMaxPcdDataBytes));
   const std::string data = h["DATA"][0];
   std::error_code ec;
-  const auto size = static_cast<std::streamoff>(fs::file_size(path, ec));
+  const auto file_size = static_cast<long long>(fs::file_size(path, ec));
+  if (ec) throw SourceError(path + ": cannot read the file's size (" + ec.message() + ")");
+  const long long body = file_size - header_end;
   if (data == "binary") {
-    if (size - header_end < static_cast<std::streamoff>(points * point_size))
-      throw SourceError(path + ": truncated PCD (binary data shorter than " + std::to_string(points) +
-                        " points)");
+    if (body < data_bytes)
+      throw SourceError(path + ": truncated PCD (binary data of " + std::to_string(body) + " bytes, " +
+                        std::to_string(points) + " points of " + std::to_string(point_size) + " bytes need " +
+                        std::to_string(data_bytes) + ")");
   } else if (data == "binary_compressed") {
-    if (size - header_end < 8) throw SourceError(path + ": truncated PCD (no compressed data)");
-  } else if (data != "ascii") {
+    if (body < 8) throw SourceError(path + ": truncated PCD (no compressed data)");
+    unsigned char w[8];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(header_end));
+    in.read(reinterpret_cast<char*>(w), 8);
+    if (in.gcount() != 8) throw SourceError(path + ": truncated PCD (no compressed data)");
+    auto le32 = [&](int o) {
+      return static_cast<long long>(w[o]) | static_cast<long long>(w[o + 1]) << 8 |
+             static_cast<long long>(w[o + 2]) << 16 | static_cast<long long>(w[o + 3]) << 24;
+    };
+    const long long compressed = le32(0), uncompressed = le32(4);
+    if (uncompressed != data_bytes)
+      throw SourceError(path + ": corrupt PCD (compressed body says " + std::to_string(uncompressed) +
+                        " bytes uncompressed, the header's " + std::to_string(points) + " points of " +
+                        std::to_string(point_size) + " bytes are " + std::to_string(data_bytes) + ")");
+    if (compressed <= 0 || compressed > body - 8)
+      throw SourceError(path + ": truncated or corrupt PCD (compressed body of " +
+                        std::to_string(compressed) + " bytes, the file holds " + std::to_string(body - 8) +
+                        " after the header)");
+  } else if (data == "ascii") {
+    // Every value is at least one character and a separator.
+    if (body < 2 * points * values - 1)
+      throw SourceError(path + ": truncated PCD (ascii data of " + std::to_string(body) +
+                        " bytes cannot hold " + std::to_string(points) + " points of " +
+                        std::to_string(values) + " values)");
+  } else {
     throw SourceError(path + ": unknown PCD DATA kind '" + data + "'");
   }
 }
@@ -141,8 +229,16 @@ RgbdFrame read_pcd_frame(const std::string& path) {
   check_pcd_header(path);
   pcl::PCLPointCloud2 blob;
   pcl::PCDReader reader;
-  if (reader.read(path, blob) < 0 || blob.data.empty())
+  int rc = -1;
+  try {
+    rc = reader.read(path, blob);
+  } catch (const std::exception& e) {  // std::bad_alloc, pcl::IOException: named with the file
+    throw SourceError(path + ": cannot read PCD (" + e.what() + ")");
+  }
+  if (rc < 0 || blob.data.empty())
     throw SourceError(path + ": cannot read PCD (corrupt, truncated or not a PCD file)");
+  if (blob.data.size() < static_cast<std::size_t>(blob.width) * blob.height * blob.point_step)
+    throw SourceError(path + ": cannot read PCD (fewer bytes than its points need)");
   if (blob.height <= 1)
     throw SourceError(path + ": not an organized point cloud (height " + std::to_string(blob.height) + ")");
   bool has_x = false, has_y = false, has_z = false, has_rgb = false;

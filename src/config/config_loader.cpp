@@ -1,15 +1,18 @@
 #include "stairguide/config/config_loader.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <initializer_list>
+#include <map>
 #include <set>
 #include <sstream>
-#include <sys/stat.h>
 #include <type_traits>
+
+#include "stairguide/config/strict_yaml.hpp"
 
 #ifndef STAIRGUIDE_SOURCE_DIR
 #define STAIRGUIDE_SOURCE_DIR ""
@@ -67,6 +70,9 @@ class Reader {
     prefix_ = saved_prefix;
   }
 
+  /// 1-based line of every key the file gives, by full name ("floor.tilt_min_deg").
+  const std::map<std::string, int>& lines() const { return lines_; }
+
   template <class T> void num(T& field, const char* key, Unit unit, double lo, double hi, const char*) {
     const YAML::Node n = static_cast<const YAML::Node&>(stack_.back())[key];
     const std::string full = prefix_ + key;
@@ -123,6 +129,7 @@ class Reader {
 
  private:
   bool present(const YAML::Node& n, const std::string& full) {
+    if (n.IsDefined() && n.Mark().line >= 0) lines_[full] = n.Mark().line + 1;
     if (n.IsDefined() && !n.IsNull()) return true;
     if (n.IsDefined() && n.IsNull()) fail(n, full, "has no value");
     if (report_) report_->missing_keys.push_back(full);
@@ -185,6 +192,7 @@ class Reader {
   ConfigLoadReport* report_;
   std::vector<YAML::Node> stack_;
   std::string prefix_;
+  std::map<std::string, int> lines_;
 };
 
 class Writer {
@@ -238,30 +246,52 @@ bool is_readable_file(const std::string& p) {
 
 }  // namespace
 
+// Bounds on a config file: the shipped one, every key commented, is about 25 kB and 700 nodes.
+// A file many times that is not a config (a 5 MB flow list once took 1.3 GB to parse).
+constexpr std::size_t kMaxConfigBytes = 1u << 20;
+constexpr YamlLimits kConfigYamlLimits{20000, 8};
+
 PipelineConfig load_config_text(const std::string& text, const std::string& name, ConfigLoadReport* report) {
+  if (text.size() > kMaxConfigBytes)
+    throw ConfigError(name + ": config is bigger than " + std::to_string(kMaxConfigBytes) +
+                      " bytes; refused");
   YAML::Node doc;
   try {
-    doc = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    doc = load_strict_yaml(text, name, kConfigYamlLimits);
+  } catch (const InputFileError& e) {
+    throw ConfigError(e.what());
   }
   PipelineConfig c;
   Reader r(name, report);
   r.root(doc, c);
-  const auto problems = check_consistency(c);
-  if (!problems.empty()) throw ConfigError(name + ": " + problems.front());
+  const auto problems = find_inconsistencies(c);
+  if (!problems.empty()) {
+    // Named at the later of the two keys in the file (the one that made the pair wrong, as read).
+    const auto& p = problems.front();
+    std::string key = p.key_b;
+    int line = -1;
+    for (const std::string* k : {&p.key_a, &p.key_b}) {
+      const auto it = r.lines().find(*k);
+      if (it != r.lines().end() && it->second > line) {
+        line = it->second;
+        key = *k;
+      }
+    }
+    throw ConfigError(name + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": key '" + key +
+                      "': " + p.message);
+  }
   return c;
 }
 
 PipelineConfig load_config(const std::string& path, ConfigLoadReport* report) {
   if (path.empty()) throw ConfigError("config: no file name given");
-  if (is_directory(path)) throw ConfigError(path + ": is a directory, not a config file");
-  std::ifstream f(path);
-  if (!f) throw ConfigError(path + ": cannot open config file (missing or unreadable)");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  if (f.bad()) throw ConfigError(path + ": read error");
-  return load_config_text(ss.str(), path, report);
+  std::string text;
+  try {
+    text = read_small_file(path, kMaxConfigBytes, "config file");
+  } catch (const InputFileError& e) {
+    throw ConfigError(e.what());
+  }
+  return load_config_text(text, path, report);
 }
 
 std::string dump_config_yaml(const PipelineConfig& config) {

@@ -89,26 +89,40 @@ bool config_equal(const PipelineConfig& a, const PipelineConfig& b, std::string*
   return cmp.diff.empty();
 }
 
-std::vector<std::string> check_consistency(const PipelineConfig& c) {
-  std::vector<std::string> out;
+std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c) {
+  std::vector<ConfigInconsistency> out;
   auto order = [&](double lo, double hi, const char* klo, const char* khi) {
-    if (lo > hi) out.push_back(std::string(klo) + " must not exceed " + khi);
+    if (lo > hi) out.push_back({klo, khi, std::string(klo) + " must not exceed " + khi});
   };
-  order(c.capture.min_range, c.capture.max_range, "capture.min_range_m", "capture.max_range_m");
+  // An empty depth range would make every reading no reading: every frame blank, silently.
+  if (!(c.capture.min_range < c.capture.max_range))
+    out.push_back({"capture.min_range_m", "capture.max_range_m",
+                   "capture.min_range_m must be below capture.max_range_m (no depth would be left)"});
   order(c.capture.retry_min, c.capture.retry_max, "capture.retry_min_s", "capture.retry_max_s");
   order(c.floor.tilt_min, c.floor.tilt_max, "floor.tilt_min_deg", "floor.tilt_max_deg");
   order(c.floor.height_min, c.floor.height_max, "floor.height_min_m", "floor.height_max_m");
   order(c.floor.search_start, c.floor.search_max, "floor.search_start_m", "floor.search_max_m");
+  order(c.floor.ambiguous_rise_min, c.floor.ambiguous_rise_max, "floor.ambiguous_rise_min_cm",
+        "floor.ambiguous_rise_max_cm");
+  order(c.floor.curb_rise_min, c.floor.curb_rise_max, "floor.curb_rise_min_cm", "floor.curb_rise_max_cm");
   order(c.manhattan.riser_min_height, c.manhattan.riser_max_height, "manhattan.riser_min_height_cm",
         "manhattan.riser_max_height_cm");
   order(c.manhattan.riser_going_min, c.manhattan.riser_going_max, "manhattan.riser_going_min_cm",
         "manhattan.riser_going_max_cm");
   order(c.classification.step_height_min, c.classification.step_height_max,
         "classification.step_height_min_cm", "classification.step_height_max_cm");
+  order(c.stair_detection.floorless_tilt_min, c.stair_detection.floorless_tilt_max,
+        "stair_detection.floorless_tilt_min_deg", "stair_detection.floorless_tilt_max_deg");
   order(c.stair_modelling.riser_min, c.stair_modelling.riser_max, "stair_modelling.riser_min_cm",
         "stair_modelling.riser_max_cm");
   order(c.stair_modelling.blondel_min, c.stair_modelling.blondel_max, "stair_modelling.blondel_min_cm",
         "stair_modelling.blondel_max_cm");
+  return out;
+}
+
+std::vector<std::string> check_consistency(const PipelineConfig& c) {
+  std::vector<std::string> out;
+  for (const auto& p : find_inconsistencies(c)) out.push_back(p.message);
   return out;
 }
 

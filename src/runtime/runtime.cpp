@@ -632,8 +632,8 @@ struct Runtime::Impl {
   void print_line(const OdoMsg* o, const PercMsg* p) {
     if (!ready_sent) {
       ready_sent = true;
-      spdlog::info("first frame through the pipeline: ready");
-      notify("READY=1\nSTATUS=running: first frame through");
+      spdlog::info("first frame through the pipeline");
+      notify("STATUS=running: first frame through");
     }
     if (!opt.frame_lines || !opt.frame_out) return;
     const std::uint64_t seq = o ? o->out.seq : p->out.seq;
@@ -713,7 +713,13 @@ struct Runtime::Impl {
         why = camera_why;
       }
       feedback->camera_lost(why);
-      notify("STATUS=camera lost: " + why + "; reconnecting");
+      bool ever = false;  // a camera that never gave a frame is not lost: it is not there yet
+      {
+        std::lock_guard<std::mutex> lk(stats_mutex);
+        ever = have_first;
+      }
+      notify(std::string(ever ? "STATUS=camera lost: " : "STATUS=waiting for camera: ") + why +
+             "; reconnecting");
     } else {
       feedback->camera_back();
     }
@@ -878,11 +884,20 @@ void Runtime::start() {
     m.set_input_desc(m.opt.input);
     spdlog::info("live input {} ({})", m.opt.input, m.opt.synchronous ? "one thread" : "threaded");
   }
-  if (m.opt.synchronous) return;
+  // READY=1 once the config is loaded, the replay opened and the threads are up, not after the
+  // first frame: without a camera plugged in that would never come, and `systemctl start`
+  // would wait for it. STATUS says what the daemon waits for.
+  const std::string ready = "READY=1\nSTATUS=" + (m.live ? "waiting for camera " + m.opt.input
+                                                         : "replaying " + m.source->describe());
+  if (m.opt.synchronous) {
+    m.notify(ready);
+    return;
+  }
   m.threads[kCapture] = std::thread([&m] { m.capture_loop(); });
   m.threads[kOdometry] = std::thread([&m] { m.odometry_loop(); });
   m.threads[kPerception] = std::thread([&m] { m.perception_loop(); });
   m.threads[kSink] = std::thread([&m] { m.sink_loop(); });
+  m.notify(ready);
 }
 
 int Runtime::run() {

@@ -21,9 +21,10 @@ class SourceError : public std::runtime_error {
 
 enum class ReadStatus {
   kOk,       ///< a frame was read
-  kEnd,      ///< the recording or sequence ended cleanly (or early: see message)
+  kEnd,      ///< the recording or sequence ended cleanly, after every frame it holds
   kTimeout,  ///< live camera: no frame within the timeout (may come back)
-  kError     ///< unreadable frame or lost device; see message
+  kError     ///< unreadable frame, lost device, or a recording that ends before the frames it
+             ///< announces (truncated); see message
 };
 
 struct ReadResult {

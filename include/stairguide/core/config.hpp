@@ -643,8 +643,18 @@ struct PipelineConfig {
   }
 };
 
-/// Cross-field checks the per-field ranges cannot express (min <= max ...). Returns one message
-/// per problem, naming the keys; empty when the config is consistent.
+/// One cross-field problem: the two keys involved (as in the file, "floor.tilt_min_deg") and the
+/// message naming them.
+struct ConfigInconsistency {
+  std::string key_a, key_b;
+  std::string message;
+};
+
+/// Cross-field checks the per-field ranges cannot express (min <= max, min < max for the depth
+/// range). Empty when the config is consistent.
+std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c);
+
+/// The messages of find_inconsistencies, one per problem.
 std::vector<std::string> check_consistency(const PipelineConfig& c);
 
 /// True when every field of `a` equals the same field of `b` (floats within 1e-6 relative).

@@ -9,8 +9,9 @@
 ///     frames it never saw are counted as `perception_skipped`),
 /// and the feedback thread joins both result streams (SPSC rings), makes the decision, measures
 /// capture-to-decision latency, prints the per-frame lines, and reports the counters (log + STATUS)
-/// every `runtime.status_interval`. READY=1 goes out when the first frame has been through the
-/// pipeline, WATCHDOG=1 from the perception loop while every thread is alive.
+/// every `runtime.status_interval`. READY=1 goes out from start() once the input is open (a
+/// replay) and the threads are up, with STATUS= "waiting for camera" on the live path (a camera
+/// may be plugged in much later); WATCHDOG=1 from the perception loop while every thread is alive.
 ///
 /// Synchronous mode: the same stages, in order, on the calling thread, every frame through every
 /// stage (tests, offline replay).
