@@ -106,6 +106,9 @@ TEST(FolderLabel, BadFilesNameTheFileLineAndKey) {
       {"both", head + "  stairs: []\nframes: []\n", "either 'folder' (one label) or 'frames'"},
       {"format", "format: other\nfolder:\n  scene: s\n  stairs: []\n", "unknown format 'other'"},
       {"down", head + "  stairs:\n    - kind: ascending\n      down: true\n", "cannot go down"},
+      // The strict reading of every YAML input (strict_yaml.hpp): the later value is not dropped.
+      {"twice", head + "  stairs: []\n  scene: t\n", "key 'folder.scene' given twice (first on line 3)"},
+      {"second_document", head + "  stairs: []\n---\nformat: x\n", "document"},
   };
   for (const Case& c : cases) {
     const fs::path d = dataset_with_label(c.name, c.text);

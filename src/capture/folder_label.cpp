@@ -10,6 +10,7 @@
 #include <string>
 
 #include "stairguide/capture/dataset.hpp"
+#include "stairguide/config/strict_yaml.hpp"
 
 namespace stairguide {
 namespace {
@@ -84,9 +85,11 @@ bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
     throw SourceError(path + ": missing or not a regular file");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw SourceError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    // The same strict reading and bounds as the per-frame labels (labels_yaml.cpp): one document,
+    // no key twice, no aliases, bounded size. A folder label is a few dozen nodes.
+    root = load_strict_yaml(read_small_file(path, 64u << 20, "labels.yaml"), path, YamlLimits{2000000, 8});
+  } catch (const InputFileError& e) {
+    throw SourceError(e.what());
   }
   if (!root || !root.IsMap() || !root["folder"]) return false;  // a per-frame file, or not ours
   FolderReader top(root, path, "labels");
