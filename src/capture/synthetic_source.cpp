@@ -31,6 +31,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
   if (!d) {
     std::string known;
     for (const auto& p : detail::preset_defs()) known += (known.empty() ? "" : ", ") + p.info.name;
+    for (const auto& p : detail::walk_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -117,6 +118,22 @@ const std::vector<PresetInfo>& presets() {
     return v;
   }();
   return list;
+}
+
+const std::vector<PresetInfo>& walk_presets() {
+  static const std::vector<PresetInfo> list = [] {
+    std::vector<PresetInfo> v;
+    for (const auto& d : detail::walk_defs()) v.push_back(d.info);
+    return v;
+  }();
+  return list;
+}
+
+const PresetInfo* find_preset_info(const std::string& name) {
+  for (const auto* l : {&presets(), &walk_presets()})
+    for (const auto& p : *l)
+      if (p.name == name) return &p;
+  return nullptr;
 }
 
 CameraIntrinsics synthetic_intrinsics(const SynthOptions& o) {

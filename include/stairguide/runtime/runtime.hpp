@@ -74,6 +74,10 @@ struct RuntimeStats {
   double latency_max_ms = 0.0;
   double odometry_ms_mean = 0.0;  ///< mean time in the odometry stage
   double perception_ms_mean = 0.0;
+  /// The traversal as of the last decision (issue 32): state token, step the user stands on,
+  /// steps left (-1 unknown), steps known.
+  std::string traversal_state = "-";
+  int traversal_step = 0, traversal_left = -1, traversal_known = 0;
   /// The systemd STATUS= text / log line for these counters.
   std::string summary() const;
 };
