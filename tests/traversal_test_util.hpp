@@ -148,11 +148,12 @@ inline WalkRun run_walk(const std::string& preset, std::uint32_t seed, const std
       rec.det_tread = stair.tread_m;
       if (std::getenv("SG_TRACE") && k == 0)
         std::printf("#%ld truth %d along %.3f | %s step %d known %d last %d in_view %d q %.2f corr h %.2f a %.2f yaw %.2f "
-                    "cm/deg | det %d %s lv %d r %.3f t %.3f floor %d wf %d\n",
+                    "cm/deg | det %d %s lv %d r %.3f t %.3f floor %d wf %d | gap a %.1f h %.1f cm\n",
                     i, rec.truth_step, rec.truth_along, to_string(rec.r.state), rec.r.step_index, rec.r.steps_known,
                     rec.r.last_known, rec.r.in_view, rec.r.quality, 100 * rec.r.corr_height_m,
                     100 * rec.r.corr_along_m, rec.r.corr_yaw_rad * 57.3f, stair.detected, to_string(stair.kind),
-                    stair.levels, stair.riser_m, stair.tread_m, scene.floor_found, stair.without_floor);
+                    stair.levels, stair.riser_m, stair.tread_m, scene.floor_found, stair.without_floor,
+                    100 * (rec.model_camera.z() - cam.z()), 100 * (rec.model_camera.y() - cam.y()));
       run.frames[k].push_back(rec);
     }
   }

@@ -72,7 +72,7 @@ float TraversalTracker::frame_quality(const StairResult& s, const Pose& /*T_worl
   const float df = 1.f / (1.f + (d / 2.5f) * (d / 2.5f));  // depth noise grows with the square of the range
   const float ends = s.width_complete ? 1.f : 0.7f;
   const float lv = std::sqrt(std::min(1.f, static_cast<float>(s.levels) / 3.f));
-  return std::clamp(pf * df * ends * lv * 1.6f, 0.f, 1.f);
+  return std::clamp(pf * df * ends * lv, 0.f, 1.f);
 }
 
 // The seen levels in the world: each tread's centroid (from its points) and a point of its edge.
@@ -138,6 +138,12 @@ bool TraversalTracker::associate(const Model& m, const StairResult& s, const Pos
   if (zd.norm() < 1e-3f) return false;
   zd.normalize();
   if (std::acos(std::clamp(zm.dot(zd), -1.f, 1.f)) > cfg_.max_yaw_disagreement) return false;
+  // A view that measures the staircase unlike the frames fused so far (a level taken for another,
+  // a merged landing) would pull the held pose off: it is not used.
+  if (std::acos(std::clamp(y.dot(det_up_), -1.f, 1.f)) > cfg_.max_tilt_disagreement) return false;
+  if (m.w_riser >= 1.0 && std::fabs(s.riser_m - m.riser) > cfg_.max_riser_disagreement) return false;
+  if (m.w_tread >= 1.0 && s.tread_m > 0.f && s.levels >= 2 && std::fabs(s.tread_m - m.tread) > cfg_.max_tread_disagreement)
+    return false;
   const Pose T_sw = m.T_world_stair.inverse();
   const float r = m.riser, t = tread_of(m), mf = cfg_.match_fraction;
   const int dir = m.direction;
@@ -177,22 +183,18 @@ void TraversalTracker::correct(Model& m, float quality, bool apply_pose) {
                                                           static_cast<double>(cfg_.correction_gain * quality))),
                              0.f, 1.f);
   Pose& T = m.T_world_stair;
-  // ---- orientation: the vertical, then the yaw (about the matched levels' centroid) ----
-  Eigen::Vector3f pivot = Eigen::Vector3f::Zero();
-  float pw = 0.f;
-  for (std::size_t i = 0; i < match_.size(); ++i) {
-    const SeenLevel& v = seen_[static_cast<std::size_t>(match_[i].seen)];
-    pivot += static_cast<float>(v.points) * v.centroid_w;
-    pw += static_cast<float>(v.points);
-  }
-  pivot /= std::max(pw, 1.f);
+  // ---- orientation: the vertical, then the yaw, about the point under the camera ----
+  // Turning about the user keeps where the user stands on the staircase (what is counted) and lets
+  // the translation below bring the levels in sight into place; turning about the levels far ahead
+  // would move the user by the angle times that distance.
+  const Eigen::Vector3f pivot = pivot_;
   const Eigen::Matrix3f R0 = T.linear();
   Eigen::Matrix3f dR = Eigen::Matrix3f::Identity();
   {
     const Eigen::Vector3f y = R0.col(1), ym = det_up_;
     const Eigen::Vector3f ax = y.cross(ym);
     const float s = ax.norm(), c = y.dot(ym);
-    if (s > 1e-6f) dR = rot(ax / s, g * std::atan2(s, c));
+    if (s > 1e-6f) dR = rot(ax / s, cfg_.tilt_gain * g * std::atan2(s, c));
     const Eigen::Vector3f y1 = dR * y;
     Eigen::Vector3f z1 = dR * R0.col(2), zm = det_forward_ - det_forward_.dot(y1) * y1;
     if (zm.norm() > 1e-3f) {
@@ -291,6 +293,7 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
                    stair.riser_m > 0.f && stair.origin().norm() <= cfg_.max_distance;
   if (det) {
     gather(stair, T_wc);
+    pivot_ = T_wc.translation();
     det_up_ = (T_wc.linear() * stair.T_camera_stair.linear().col(1)).normalized();
     det_forward_ = (T_wc.linear() * stair.T_camera_stair.linear().col(2)).normalized();
   }

@@ -515,9 +515,13 @@ struct TraversalConfig {
   float memory_time = 30.0f;       ///< s a staircase out of view is remembered in the world
   float landing_factor = 1.8f;     ///< a tread this many goings deep is the last one (landing, floor)
   float correction_gain = 0.3f;    ///< share of the live view's residual applied per frame (times its quality)
+  float tilt_gain = 0.25f;         ///< share of the correction gain given to the vertical (the odometry's tilt drifts little)
   bool correct = true;             ///< correct the held pose from the live view (eq. 15); false: odometry only (eq. 14)
   float match_fraction = 0.4f;     ///< a level matches a step within this share of the riser (height) and tread (edge)
   float max_yaw_disagreement = 0.34906585f;  ///< rad, a detection further than this from the model's axes is another staircase (20 deg)
+  float max_riser_disagreement = 0.015f;  ///< m, a view whose riser differs more from the fused one is not used
+  float max_tread_disagreement = 0.03f;   ///< m, ... whose tread differs more
+  float max_tilt_disagreement = 0.034906585f;  ///< rad, ... whose vertical differs more from the held one (2 deg)
   float arrive_margin = 0.25f;     ///< m past the last edge at which the user has arrived
   float arrive_hold = 1.5f;        ///< s the arrival is reported before searching again
   float default_tread = 0.29f;     ///< m, going assumed until one is measured (one level seen)
@@ -541,11 +545,19 @@ struct TraversalConfig {
           "a tread this many goings deep is the last one (a landing or the floor beyond)");
     v.num(correction_gain, "correction_gain_percent", Unit::kPercent, 0, 100,
           "share of the live view's residual (height, along, yaw, vertical) applied each frame, times its quality");
+    v.num(tilt_gain, "tilt_gain_percent", Unit::kPercent, 0, 100,
+          "share of the correction gain applied to the vertical (the odometry's tilt drifts little; a view's vertical is noisy)");
     v.flag(correct, "correct", "correct the odometry-held stair pose from the live view (paper eq. 15)");
     v.num(match_fraction, "match_percent", Unit::kPercent, 5, 50,
           "a seen level matches a step of the model within this share of the riser (height) and tread (edge)");
     v.num(max_yaw_disagreement, "max_yaw_disagreement_deg", Unit::kDegree, 1, 90,
           "a detection whose axes differ more than this from the held staircase's is another staircase");
+    v.num(max_riser_disagreement, "max_riser_disagreement_cm", Unit::kCentimetre, 0.1, 10,
+          "a view whose riser differs more than this from the fused riser does not correct the staircase");
+    v.num(max_tread_disagreement, "max_tread_disagreement_cm", Unit::kCentimetre, 0.1, 20,
+          "a view whose tread differs more than this from the fused tread does not correct the staircase");
+    v.num(max_tilt_disagreement, "max_tilt_disagreement_deg", Unit::kDegree, 0.1, 45,
+          "a view whose vertical differs more than this from the held staircase's does not correct it");
     v.num(arrive_margin, "arrive_margin_cm", Unit::kCentimetre, 0, 200,
           "the user has arrived this far past the last step edge");
     v.num(arrive_hold, "arrive_hold_s", Unit::kSecond, 0, 60, "the arrival is reported this long, then searching again");

@@ -102,6 +102,7 @@ class TraversalTracker {
   std::vector<float> dz_;
   Eigen::Vector3f det_up_ = Eigen::Vector3f::UnitY(), det_forward_ = Eigen::Vector3f::UnitZ();  // world
   bool remembered_ = false;
+  Eigen::Vector3f pivot_ = Eigen::Vector3f::Zero();  // world, what the orientation correction turns about
   Pose T_world_camera_last_ = Pose::Identity();
   bool have_last_ = false;
   std::uint64_t track_ = 0;
