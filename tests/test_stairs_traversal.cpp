@@ -73,10 +73,11 @@ TEST(TraversalDrift, CorrectedFromTheLiveView) {
 }
 
 // The fused model (riser, tread over the frames, weighted by quality) is closer to the truth than
-// the single frames it was made of, on the same frames.
+// the single frames it was made of, on the same frames, with the depth noise correlated in space
+// as the real sensor's (synth::with_real_kinect_noise()).
 TEST(TraversalFusion, FusedDimensionsBeatSingleFrames) {
   for (const char* walk : {"climb_8_steps", "descend_8_steps"}) {
-    const sgtest::WalkRun run = sgtest::run_walk(walk, seed(), {plain()});
+    const sgtest::WalkRun run = sgtest::run_walk(walk, seed(), {plain()}, 15.0, -1, 0, /*real_noise=*/true);
     const sgtest::TraversalFigures F = sgtest::score(run, 0);
     sgtest::print(run, "fusion", F);
     ASSERT_GE(F.fused_frames, 20) << walk;

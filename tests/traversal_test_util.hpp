@@ -90,9 +90,9 @@ inline void hide_upper_half(stairguide::RgbdFrame& f) {
 /// Every frame of `preset` at `fps` through perception, the stairs stage and each variant's
 /// tracker; frames [hide_from, hide_from + hide_count) have the upper half of their depth hidden.
 inline WalkRun run_walk(const std::string& preset, std::uint32_t seed, const std::vector<Variant>& variants,
-                        double fps = 15.0, long hide_from = -1, long hide_count = 0) {
+                        double fps = 15.0, long hide_from = -1, long hide_count = 0, bool real_noise = false) {
   using namespace stairguide;
-  synth::SynthOptions opt;
+  synth::SynthOptions opt = real_noise ? synth::with_real_kinect_noise() : synth::SynthOptions{};
   opt.fps = fps;
   const synth::PresetInfo* info = synth::find_preset_info(preset);
   const long frames = info ? static_cast<long>(std::ceil(static_cast<double>(info->default_frames) * fps / 30.0)) : 1;

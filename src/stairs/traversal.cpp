@@ -52,6 +52,7 @@ TraversalTracker::TraversalTracker(const TraversalConfig& config) : cfg_(config)
   seen_.reserve(32);
   match_.reserve(32);
   dz_.reserve(32);
+  dy_.reserve(32);
 }
 
 void TraversalTracker::reset() {
@@ -209,18 +210,18 @@ void TraversalTracker::correct(Model& m, float quality, bool apply_pose) {
   // ---- position: heights from the tread centroids, along from the edges in sight ----
   const Pose T_sw = T.inverse();
   const float r = m.riser, t = tread_of(m);
-  double sy = 0, swy = 0;
+  // Medians: one level taken for another (a landing merged with a tread) must not pull the rest.
   std::vector<float>& dz = dz_;
+  std::vector<float>& dy = dy_;
   dz.clear();
+  dy.clear();
   for (std::size_t i = 0; i < match_.size(); ++i) {
     const Match& mt = match_[i];
     const SeenLevel& v = seen_[static_cast<std::size_t>(match_[i].seen)];
-    const float dy = (T_sw * v.centroid_w).y() - tread_height(m.direction, mt.step, r);
-    sy += static_cast<double>(v.points) * dy;
-    swy += v.points;
+    dy.push_back((T_sw * v.centroid_w).y() - tread_height(m.direction, mt.step, r));
     if (mt.has_dz) dz.push_back((T_sw * v.edge_w).z() - edge_position(m.direction, mt.step, t));
   }
-  const float cy = swy > 0 ? static_cast<float>(sy / swy) : 0.f;
+  const float cy = dy.empty() ? 0.f : median_of(dy);
   const float cz = dz.empty() ? 0.f : median_of(dz);
   // Across the stair (x_S) the view says nothing: the odometry is trusted.
   T.translation() += T.linear() * Eigen::Vector3f(0.f, g * cy, g * cz);
@@ -289,8 +290,11 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
   have_last_ = true;
 
   // ---- this frame's detection ----
-  const bool det = stair.detected && is_flight(stair.kind) && stair.direction() != 0 && stair.levels >= 1 &&
-                   stair.riser_m > 0.f && stair.origin().norm() <= cfg_.max_distance;
+  // A single step or a curb is what the end of a flight looks like from its last steps (the last
+  // riser and the landing, the last drop to the floor): it corrects a staircase held, never starts one.
+  const bool det = stair.detected && (is_flight(stair.kind) || (model_.valid && stair.kind != StairKind::kNone)) &&
+                   stair.direction() != 0 && stair.levels >= 1 && stair.riser_m > 0.f &&
+                   stair.origin().norm() <= cfg_.max_distance;
   if (det) {
     gather(stair, T_wc);
     pivot_ = T_wc.translation();
@@ -315,12 +319,12 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
     for (const Match& mt : match_) first_edge_seen |= mt.has_dz && mt.step == (model_.direction > 0 ? 1 : 0);
     const bool apply = cfg_.correct || (first_edge_seen && body_along(model_) < 0.f);
     correct(model_, quality, apply);
-    fuse_dimensions(model_, stair, quality);
+    if (is_flight(stair.kind)) fuse_dimensions(model_, stair, quality);
     grow(model_);
     model_.last_seen = now;
     ++model_.hits;
     used = true;
-  } else if (det && !stair.without_floor) {
+  } else if (det && !stair.without_floor && is_flight(stair.kind)) {
     // A staircase not (or no longer) held: confirmed over a few frames before it is taken.
     if (candidate_.valid && now - candidate_.last_seen <= cfg_.confirm_window && associate(candidate_, stair, T_wc)) {
       correct(candidate_, quality, true);

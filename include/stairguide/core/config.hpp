@@ -519,7 +519,7 @@ struct TraversalConfig {
   bool correct = true;             ///< correct the held pose from the live view (eq. 15); false: odometry only (eq. 14)
   float match_fraction = 0.4f;     ///< a level matches a step within this share of the riser (height) and tread (edge)
   float max_yaw_disagreement = 0.34906585f;  ///< rad, a detection further than this from the model's axes is another staircase (20 deg)
-  float max_riser_disagreement = 0.015f;  ///< m, a view whose riser differs more from the fused one is not used
+  float max_riser_disagreement = 0.01f;   ///< m, a view whose riser differs more from the fused one is not used
   float max_tread_disagreement = 0.03f;   ///< m, ... whose tread differs more
   float max_tilt_disagreement = 0.034906585f;  ///< rad, ... whose vertical differs more from the held one (2 deg)
   float arrive_margin = 0.25f;     ///< m past the last edge at which the user has arrived

@@ -99,7 +99,7 @@ class TraversalTracker {
     int seen = 0;  // index into seen_
   };
   std::vector<Match> match_;
-  std::vector<float> dz_;
+  std::vector<float> dz_, dy_;
   Eigen::Vector3f det_up_ = Eigen::Vector3f::UnitY(), det_forward_ = Eigen::Vector3f::UnitZ();  // world
   bool remembered_ = false;
   Eigen::Vector3f pivot_ = Eigen::Vector3f::Zero();  // world, what the orientation correction turns about
