@@ -213,13 +213,14 @@ int main(int argc, char** argv) {
   if (replay && args.frame_lines) {
     std::printf(
         "summary frames=%llu odometry_frames=%llu odometry_lost=%llu perception_frames=%llu "
-        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s\n",
+        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s traversal=%s "
+        "traversal_step=%d traversal_left=%d traversal_known=%d\n",
         static_cast<unsigned long long>(st.frames_captured),
         static_cast<unsigned long long>(st.odometry_frames),
         static_cast<unsigned long long>(st.odometry_frames_lost),
         static_cast<unsigned long long>(st.perception_frames),
         static_cast<unsigned long long>(st.perception_skipped), st.fps, st.latency_p50_ms, st.latency_p99_ms,
-        st.state.c_str());
+        st.state.c_str(), st.traversal_state.c_str(), st.traversal_step, st.traversal_left, st.traversal_known);
   }
   std::fflush(stdout);
   spdlog::default_logger()->flush();
