@@ -53,6 +53,7 @@ TraversalTracker::TraversalTracker(const TraversalConfig& config) : cfg_(config)
   match_.reserve(32);
   dz_.reserve(32);
   dy_.reserve(32);
+  near_.reserve(32);
 }
 
 void TraversalTracker::reset() {
@@ -104,7 +105,10 @@ void TraversalTracker::gather(const StairResult& s, const Pose& T_world_camera) 
   }
   // Descending, the edge where the user's level ends (the origin) is the dangerous one: it counts
   // as the far edge of the level the user stands on.
-  if (dir < 0 && !s.without_floor) {
+  // Only where the floor's edge was measured: with the floor remembered, the origin is placed one
+  // tread before the first edge seen, an assumption that would pull the held pose by its error.
+  origin_level_ = dir < 0 && !s.without_floor && !s.floor_remembered && floor_seen_;
+  if (origin_level_) {
     SeenLevel v;
     v.points = 1000;
     v.centroid_w = T_world_det.translation();
@@ -153,7 +157,7 @@ bool TraversalTracker::associate(const Model& m, const StairResult& s, const Pos
     const Eigen::Vector3f p = T_sw * v.centroid_w;
     Match mt;
     mt.step = dir > 0 ? static_cast<int>(std::lround(p.y() / r)) + 1 : static_cast<int>(std::lround(-p.y() / r));
-    const bool origin_level = dir < 0 && i + 1 == seen_.size() && !s.without_floor;
+    const bool origin_level = origin_level_ && i + 1 == seen_.size();
     if (mt.step < (origin_level ? 0 : 1)) continue;
     if (m.last_known && mt.step > m.last_step) continue;
     mt.dy = p.y() - tread_height(dir, mt.step, r);
@@ -210,16 +214,26 @@ void TraversalTracker::correct(Model& m, float quality, bool apply_pose) {
   // ---- position: heights from the tread centroids, along from the edges in sight ----
   const Pose T_sw = T.inverse();
   const float r = m.riser, t = tread_of(m);
-  // Medians: one level taken for another (a landing merged with a tread) must not pull the rest.
+  // From the levels nearest the user (the next steps, what is counted; depth noise grows with the
+  // square of the range): the median of the nearest few, so that one level taken for another (a
+  // landing merged with a tread) does not pull the rest.
+  near_.clear();
+  for (std::size_t i = 0; i < match_.size(); ++i) {
+    const SeenLevel& v = seen_[static_cast<std::size_t>(match_[i].seen)];
+    near_.emplace_back((v.centroid_w - pivot).squaredNorm(), static_cast<int>(i));
+  }
+  std::sort(near_.begin(), near_.end());
   std::vector<float>& dz = dz_;
   std::vector<float>& dy = dy_;
   dz.clear();
   dy.clear();
-  for (std::size_t i = 0; i < match_.size(); ++i) {
-    const Match& mt = match_[i];
-    const SeenLevel& v = seen_[static_cast<std::size_t>(match_[i].seen)];
-    dy.push_back((T_sw * v.centroid_w).y() - tread_height(m.direction, mt.step, r));
-    if (mt.has_dz) dz.push_back((T_sw * v.edge_w).z() - edge_position(m.direction, mt.step, t));
+  for (const auto& [d2, i] : near_) {
+    const Match& mt = match_[static_cast<std::size_t>(i)];
+    const SeenLevel& v = seen_[static_cast<std::size_t>(mt.seen)];
+    if (static_cast<int>(dy.size()) < cfg_.near_levels)
+      dy.push_back((T_sw * v.centroid_w).y() - tread_height(m.direction, mt.step, r));
+    if (mt.has_dz && static_cast<int>(dz.size()) < cfg_.near_levels)
+      dz.push_back((T_sw * v.edge_w).z() - edge_position(m.direction, mt.step, t));
   }
   const float cy = dy.empty() ? 0.f : median_of(dy);
   const float cz = dz.empty() ? 0.f : median_of(dz);
@@ -296,6 +310,7 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
                    stair.direction() != 0 && stair.levels >= 1 && stair.riser_m > 0.f &&
                    stair.origin().norm() <= cfg_.max_distance;
   if (det) {
+    floor_seen_ = scene.floor_found;
     gather(stair, T_wc);
     pivot_ = T_wc.translation();
     det_up_ = (T_wc.linear() * stair.T_camera_stair.linear().col(1)).normalized();

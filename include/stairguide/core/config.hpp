@@ -514,7 +514,7 @@ struct TraversalConfig {
   float lost_time = 2.0f;          ///< s unseen before the foot, after which the staircase is no longer "ahead"
   float memory_time = 30.0f;       ///< s a staircase out of view is remembered in the world
   float landing_factor = 1.8f;     ///< a tread this many goings deep is the last one (landing, floor)
-  float correction_gain = 0.3f;    ///< share of the live view's residual applied per frame (times its quality)
+  float correction_gain = 0.15f;   ///< share of the live view's residual applied per frame (times its quality)
   float tilt_gain = 0.25f;         ///< share of the correction gain given to the vertical (the odometry's tilt drifts little)
   bool correct = true;             ///< correct the held pose from the live view (eq. 15); false: odometry only (eq. 14)
   float match_fraction = 0.4f;     ///< a level matches a step within this share of the riser (height) and tread (edge)
@@ -522,6 +522,7 @@ struct TraversalConfig {
   float max_riser_disagreement = 0.01f;   ///< m, a view whose riser differs more from the fused one is not used
   float max_tread_disagreement = 0.03f;   ///< m, ... whose tread differs more
   float max_tilt_disagreement = 0.034906585f;  ///< rad, ... whose vertical differs more from the held one (2 deg)
+  int near_levels = 3;             ///< the levels nearest the user whose residuals correct the pose (median)
   float arrive_margin = 0.25f;     ///< m past the last edge at which the user has arrived
   float arrive_hold = 1.5f;        ///< s the arrival is reported before searching again
   float default_tread = 0.29f;     ///< m, going assumed until one is measured (one level seen)
@@ -558,6 +559,8 @@ struct TraversalConfig {
           "a view whose tread differs more than this from the fused tread does not correct the staircase");
     v.num(max_tilt_disagreement, "max_tilt_disagreement_deg", Unit::kDegree, 0.1, 45,
           "a view whose vertical differs more than this from the held staircase's does not correct it");
+    v.num(near_levels, "near_levels", Unit::kCount, 1, 50,
+          "the levels nearest the user whose height and edge residuals (their median) correct the held pose");
     v.num(arrive_margin, "arrive_margin_cm", Unit::kCentimetre, 0, 200,
           "the user has arrived this far past the last step edge");
     v.num(arrive_hold, "arrive_hold_s", Unit::kSecond, 0, 60, "the arrival is reported this long, then searching again");

@@ -22,6 +22,7 @@
 /// at z_S in that span (0 before the first edge), as the synthetic ground truth counts it.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "stairguide/core/config.hpp"
@@ -100,8 +101,10 @@ class TraversalTracker {
   };
   std::vector<Match> match_;
   std::vector<float> dz_, dy_;
+  std::vector<std::pair<float, int>> near_;  // squared distance to the camera, index into match_
   Eigen::Vector3f det_up_ = Eigen::Vector3f::UnitY(), det_forward_ = Eigen::Vector3f::UnitZ();  // world
   bool remembered_ = false;
+  bool floor_seen_ = false, origin_level_ = false;  // this frame: the floor found; the origin is a measured edge
   Eigen::Vector3f pivot_ = Eigen::Vector3f::Zero();  // world, what the orientation correction turns about
   Pose T_world_camera_last_ = Pose::Identity();
   bool have_last_ = false;
