@@ -33,9 +33,10 @@ TEST(CliTraversal, ReplayThenEvalAClimb) {
   EXPECT_GT(std::filesystem::file_size(dir + "/traversal.png"), 1000u);
   const auto e = run("eval-traversal " + dir + " --json");
   ASSERT_EQ(e.code, 0) << e.out;
-  for (const char* key : {"sequences", "frames_on_stairs", "step_index_accuracy", "count_exact", "phantom_steps",
-                          "missed_last_step", "gap_corrected_max_m", "gap_uncorrected_max_m", "fused_riser_err_m",
-                          "fused_tread_err_m", "single_frame_riser_err_m", "single_frame_tread_err_m"})
+  for (const char* key :
+       {"sequences", "frames_on_stairs", "step_index_accuracy", "count_exact", "phantom_steps",
+        "missed_last_step", "gap_corrected_max_m", "gap_uncorrected_max_m", "fused_riser_err_m",
+        "fused_tread_err_m", "single_frame_riser_err_m", "single_frame_tread_err_m"})
     EXPECT_NE(e.out.find(std::string("\"") + key + "\""), std::string::npos) << key << " in " << e.out;
   EXPECT_NE(e.out.find("\"count_exact\": 1"), std::string::npos) << e.out;
   EXPECT_NE(e.out.find("\"phantom_steps\": 0"), std::string::npos) << e.out;

@@ -67,13 +67,15 @@ Figures run(const std::string& walk, std::uint32_t seed) {
     if (r.state == TraversalState::kOnStairs || r.state == TraversalState::kLastStep ||
         r.state == TraversalState::kArrived)
       F.climbed = std::max(F.climbed, r.steps_climbed);
-    if (!F.last_announced && r.state == TraversalState::kLastStep && st.user_step < N) F.last_announced = true;
+    if (!F.last_announced && r.state == TraversalState::kLastStep && st.user_step < N)
+      F.last_announced = true;
     F.arrived |= r.state == TraversalState::kArrived;
   }
-  std::printf("%-18s our odometry: on the flight %d frames, step right %d (%.1f%%), climbed %d of %d, phantom %d, "
-              "last announced %d, arrived %d, odometry failures %d\n",
-              walk.c_str(), F.on_stairs, F.right, 100.0 * F.right / std::max(1, F.on_stairs), F.climbed, N, F.phantom,
-              F.last_announced, F.arrived, F.odometry_failures);
+  std::printf(
+      "%-18s our odometry: on the flight %d frames, step right %d (%.1f%%), climbed %d of %d, phantom %d, "
+      "last announced %d, arrived %d, odometry failures %d\n",
+      walk.c_str(), F.on_stairs, F.right, 100.0 * F.right / std::max(1, F.on_stairs), F.climbed, N, F.phantom,
+      F.last_announced, F.arrived, F.odometry_failures);
   EXPECT_EQ(F.climbed, N) << walk;
   return F;
 }

@@ -42,9 +42,10 @@ TEST_P(TraversalWalk, CountsEveryStep) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Walks, TraversalWalk,
-                         ::testing::Values("climb_3_steps", "climb_8_steps", "climb_14_steps", "climb_8_pause_turn",
-                                           "climb_8_person", "descend_3_steps", "descend_8_steps", "descend_14_steps",
-                                           "descend_8_pause_turn", "descend_8_person"));
+                         ::testing::Values("climb_3_steps", "climb_8_steps", "climb_14_steps",
+                                           "climb_8_pause_turn", "climb_8_person", "descend_3_steps",
+                                           "descend_8_steps", "descend_14_steps", "descend_8_pause_turn",
+                                           "descend_8_person"));
 
 // Drift injected into the odometry (every increment 2% long, the world turning 1 deg/s about the
 // vertical): corrected from the live view (eq. 15), the camera's height and along-stair position
@@ -128,8 +129,8 @@ TEST(TraversalReal, KitchenNeverLeavesSearching) {
     for (const TimedPose& p : poses)
       if (std::fabs(p.timestamp - f.timestamp) < 0.005) pose = &p;
     with_pose += pose != nullptr;
-    const TraversalResult& r =
-        tracker.update(scene, stair, pose ? pose->T_world_camera : Pose::Identity(), pose != nullptr, f.timestamp);
+    const TraversalResult& r = tracker.update(scene, stair, pose ? pose->T_world_camera : Pose::Identity(),
+                                              pose != nullptr, f.timestamp);
     ++frames;
     detections += stair.detected;
     not_searching += r.state != TraversalState::kSearching;
@@ -188,7 +189,8 @@ TEST(TraversalMemory, AStaircaseOutOfViewIsRemembered) {
   EXPECT_EQ(r.step_index, 1);
   EXPECT_TRUE(r.remembered);
   // Back off the flight and away for longer than the memory: forgotten.
-  for (int i = 0; i < 15 * 31; ++i) r = tracker.update(scene, none, truth.T_world_camera, true, t += 1.0 / 15);
+  for (int i = 0; i < 15 * 31; ++i)
+    r = tracker.update(scene, none, truth.T_world_camera, true, t += 1.0 / 15);
   EXPECT_EQ(r.state, TraversalState::kSearching);
   EXPECT_FALSE(tracker.holding());
 }

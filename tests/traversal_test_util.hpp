@@ -33,8 +33,8 @@ class DriftedOdometry {
  public:
   explicit DriftedOdometry(Drift d) : d_(d) {}
   stairguide::Pose operator()(const stairguide::Pose& truth, double t) {
-    const Eigen::Matrix3f Rz = Eigen::AngleAxisf(d_.yaw_rate * static_cast<float>(t), Eigen::Vector3f::UnitZ())
-                                   .toRotationMatrix();
+    const Eigen::Matrix3f Rz =
+        Eigen::AngleAxisf(d_.yaw_rate * static_cast<float>(t), Eigen::Vector3f::UnitZ()).toRotationMatrix();
     if (!have_) {
       p_ = truth.translation();
       have_ = true;
@@ -65,11 +65,11 @@ struct Variant {
 struct FrameRecord {
   long index = 0;
   int truth_step = 0;
-  float truth_along = 0.f;           // the body centre along z_S (truth)
-  Eigen::Vector3f truth_camera;      // the camera in the true stair frame
-  Eigen::Vector3f model_camera;      // the camera in the tracker's stair frame (NaN without one)
+  float truth_along = 0.f;       // the body centre along z_S (truth)
+  Eigen::Vector3f truth_camera;  // the camera in the true stair frame
+  Eigen::Vector3f model_camera;  // the camera in the tracker's stair frame (NaN without one)
   stairguide::TraversalResult r;
-  bool detected = false;             // the stairs stage found the staircase of the truth's direction
+  bool detected = false;  // the stairs stage found the staircase of the truth's direction
   float det_riser = 0.f, det_tread = 0.f;
 };
 
@@ -83,19 +83,19 @@ struct WalkRun {
 };
 
 /// Blanks the depth of the upper half of the image (the far steps): something standing in front.
-inline void hide_upper_half(stairguide::RgbdFrame& f) {
-  f.depth.rowRange(0, f.depth.rows / 2).setTo(0.f);
-}
+inline void hide_upper_half(stairguide::RgbdFrame& f) { f.depth.rowRange(0, f.depth.rows / 2).setTo(0.f); }
 
 /// Every frame of `preset` at `fps` through perception, the stairs stage and each variant's
 /// tracker; frames [hide_from, hide_from + hide_count) have the upper half of their depth hidden.
 inline WalkRun run_walk(const std::string& preset, std::uint32_t seed, const std::vector<Variant>& variants,
-                        double fps = 15.0, long hide_from = -1, long hide_count = 0, bool real_noise = false) {
+                        double fps = 15.0, long hide_from = -1, long hide_count = 0,
+                        bool real_noise = false) {
   using namespace stairguide;
   synth::SynthOptions opt = real_noise ? synth::with_real_kinect_noise() : synth::SynthOptions{};
   opt.fps = fps;
   const synth::PresetInfo* info = synth::find_preset_info(preset);
-  const long frames = info ? static_cast<long>(std::ceil(static_cast<double>(info->default_frames) * fps / 30.0)) : 1;
+  const long frames =
+      info ? static_cast<long>(std::ceil(static_cast<double>(info->default_frames) * fps / 30.0)) : 1;
   auto src = synth::make_source(preset, frames, seed, opt);
   PipelineConfig cfg;
   Perception perception(cfg);
@@ -140,20 +140,23 @@ inline WalkRun run_walk(const std::string& preset, std::uint32_t seed, const std
       rec.truth_along = (cam - 0.12f * fwd).z();
       rec.r = trackers[k].update(scene, stair, T_wc, true, f.timestamp);
       run.tracker_ms.push_back(rec.r.ms);
-      rec.model_camera = rec.r.direction != 0 ? Eigen::Vector3f(rec.r.T_world_stair.inverse() * T_wc.translation())
-                                              : Eigen::Vector3f::Constant(std::nanf(""));
+      rec.model_camera = rec.r.direction != 0
+                             ? Eigen::Vector3f(rec.r.T_world_stair.inverse() * T_wc.translation())
+                             : Eigen::Vector3f::Constant(std::nanf(""));
       rec.detected = stair.detected && stair.direction() == run.direction &&
                      (stair.kind == StairKind::kAscending || stair.kind == StairKind::kDescending);
       rec.det_riser = stair.riser_m;
       rec.det_tread = stair.tread_m;
       if (std::getenv("SG_TRACE") && k == 0)
-        std::printf("#%ld truth %d along %.3f | %s step %d known %d last %d in_view %d q %.2f corr h %.2f a %.2f yaw %.2f "
-                    "cm/deg | det %d %s lv %d r %.3f t %.3f floor %d wf %d | gap a %.1f h %.1f cm\n",
-                    i, rec.truth_step, rec.truth_along, to_string(rec.r.state), rec.r.step_index, rec.r.steps_known,
-                    rec.r.last_known, rec.r.in_view, rec.r.quality, 100 * rec.r.corr_height_m,
-                    100 * rec.r.corr_along_m, rec.r.corr_yaw_rad * 57.3f, stair.detected, to_string(stair.kind),
-                    stair.levels, stair.riser_m, stair.tread_m, scene.floor_found, stair.without_floor,
-                    100 * (rec.model_camera.z() - cam.z()), 100 * (rec.model_camera.y() - cam.y()));
+        std::printf(
+            "#%ld truth %d along %.3f | %s step %d known %d last %d in_view %d q %.2f corr h %.2f a %.2f yaw "
+            "%.2f "
+            "cm/deg | det %d %s lv %d r %.3f t %.3f floor %d wf %d | gap a %.1f h %.1f cm\n",
+            i, rec.truth_step, rec.truth_along, to_string(rec.r.state), rec.r.step_index, rec.r.steps_known,
+            rec.r.last_known, rec.r.in_view, rec.r.quality, 100 * rec.r.corr_height_m,
+            100 * rec.r.corr_along_m, rec.r.corr_yaw_rad * 57.3f, stair.detected, to_string(stair.kind),
+            stair.levels, stair.riser_m, stair.tread_m, scene.floor_found, stair.without_floor,
+            100 * (rec.model_camera.z() - cam.z()), 100 * (rec.model_camera.y() - cam.y()));
       run.frames[k].push_back(rec);
     }
   }
@@ -168,7 +171,7 @@ struct TraversalFigures {
   bool last_announced = false;   // last_step (or arrived) reported while the truth step < steps
   long last_announced_at = -1, foot_on_last_at = -1;
   bool arrived = false;
-  int left_searching = 0;        // frames not searching
+  int left_searching = 0;                    // frames not searching
   std::vector<float> gap_along, gap_height;  // per step 1..N, at the first frame on it (m, signed)
   double single_riser = 0, single_tread = 0, fused_riser = 0, fused_tread = 0;
   int fused_frames = 0;
@@ -230,13 +233,15 @@ inline TraversalFigures score(const WalkRun& run, std::size_t variant) {
 }
 
 inline void print(const WalkRun& run, const std::string& variant, const TraversalFigures& F) {
-  std::printf("%-22s %-12s N=%2d on-stairs %3d right %3d (%.1f%%) climbed %d phantom %d last-announced %s (frame %ld, "
-              "foot on it %ld) arrived %d | riser err single %.2f fused %.2f cm, tread single %.2f fused %.2f cm (%d "
-              "frames)\n",
-              run.preset.c_str(), variant.c_str(), run.steps, F.on_stairs, F.right,
-              100.0 * F.right / std::max(1, F.on_stairs), F.final_climbed, F.phantom, F.last_announced ? "yes" : "NO",
-              F.last_announced_at, F.foot_on_last_at, F.arrived, 100 * F.single_riser, 100 * F.fused_riser,
-              100 * F.single_tread, 100 * F.fused_tread, F.fused_frames);
+  std::printf(
+      "%-22s %-12s N=%2d on-stairs %3d right %3d (%.1f%%) climbed %d phantom %d last-announced %s (frame "
+      "%ld, "
+      "foot on it %ld) arrived %d | riser err single %.2f fused %.2f cm, tread single %.2f fused %.2f cm (%d "
+      "frames)\n",
+      run.preset.c_str(), variant.c_str(), run.steps, F.on_stairs, F.right,
+      100.0 * F.right / std::max(1, F.on_stairs), F.final_climbed, F.phantom, F.last_announced ? "yes" : "NO",
+      F.last_announced_at, F.foot_on_last_at, F.arrived, 100 * F.single_riser, 100 * F.fused_riser,
+      100 * F.single_tread, 100 * F.fused_tread, F.fused_frames);
   std::printf("   gap along (cm):");
   for (float g : F.gap_along) std::printf(" %5.1f", 100.f * g);
   std::printf("\n   gap height (cm):");

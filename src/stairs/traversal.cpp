@@ -64,11 +64,14 @@ void TraversalTracker::reset() {
   arrived_at_ = -1.0;
 }
 
-float TraversalTracker::tread_of(const Model& m) const { return m.tread > 0.f ? m.tread : cfg_.default_tread; }
+float TraversalTracker::tread_of(const Model& m) const {
+  return m.tread > 0.f ? m.tread : cfg_.default_tread;
+}
 
 float TraversalTracker::frame_quality(const StairResult& s, const Pose& /*T_world_camera*/) const {
   int points = 0;
-  for (std::size_t k = 1; k < s.level_data.size(); ++k) points += static_cast<int>(s.level_data[k].points.size());
+  for (std::size_t k = 1; k < s.level_data.size(); ++k)
+    points += static_cast<int>(s.level_data[k].points.size());
   const float pf = std::clamp(static_cast<float>(points) / 3000.f, 0.1f, 1.f);
   const float d = s.origin().norm();
   const float df = 1.f / (1.f + (d / 2.5f) * (d / 2.5f));  // depth noise grows with the square of the range
@@ -118,7 +121,8 @@ void TraversalTracker::gather(const StairResult& s, const Pose& T_world_camera) 
   }
 }
 
-bool TraversalTracker::start_model(Model& m, const StairResult& s, const Pose& T_world_camera, double t) const {
+bool TraversalTracker::start_model(Model& m, const StairResult& s, const Pose& T_world_camera,
+                                   double t) const {
   m = Model{};
   m.valid = true;
   m.direction = s.direction();
@@ -147,7 +151,8 @@ bool TraversalTracker::associate(const Model& m, const StairResult& s, const Pos
   // a merged landing) would pull the held pose off: it is not used.
   if (std::acos(std::clamp(y.dot(det_up_), -1.f, 1.f)) > cfg_.max_tilt_disagreement) return false;
   if (m.w_riser >= 1.0 && std::fabs(s.riser_m - m.riser) > cfg_.max_riser_disagreement) return false;
-  if (m.w_tread >= 1.0 && s.tread_m > 0.f && s.levels >= 2 && std::fabs(s.tread_m - m.tread) > cfg_.max_tread_disagreement)
+  if (m.w_tread >= 1.0 && s.tread_m > 0.f && s.levels >= 2 &&
+      std::fabs(s.tread_m - m.tread) > cfg_.max_tread_disagreement)
     return false;
   const Pose T_sw = m.T_world_stair.inverse();
   const float r = m.riser, t = tread_of(m), mf = cfg_.match_fraction;
@@ -156,7 +161,8 @@ bool TraversalTracker::associate(const Model& m, const StairResult& s, const Pos
     const SeenLevel& v = seen_[i];
     const Eigen::Vector3f p = T_sw * v.centroid_w;
     Match mt;
-    mt.step = dir > 0 ? static_cast<int>(std::lround(p.y() / r)) + 1 : static_cast<int>(std::lround(-p.y() / r));
+    mt.step =
+        dir > 0 ? static_cast<int>(std::lround(p.y() / r)) + 1 : static_cast<int>(std::lround(-p.y() / r));
     const bool origin_level = origin_level_ && i + 1 == seen_.size();
     if (mt.step < (origin_level ? 0 : 1)) continue;
     if (m.last_known && mt.step > m.last_step) continue;
@@ -184,9 +190,10 @@ void TraversalTracker::correct(Model& m, float quality, bool apply_pose) {
   m.weight += quality;
   // The first views average (the pose is their quality-weighted mean); later ones follow the
   // drift with at least the configured gain.
-  const float g = std::clamp(static_cast<float>(std::max(static_cast<double>(quality) / std::max(1e-6, w_prior + quality),
-                                                          static_cast<double>(cfg_.correction_gain * quality))),
-                             0.f, 1.f);
+  const float g =
+      std::clamp(static_cast<float>(std::max(static_cast<double>(quality) / std::max(1e-6, w_prior + quality),
+                                             static_cast<double>(cfg_.correction_gain * quality))),
+                 0.f, 1.f);
   Pose& T = m.T_world_stair;
   // ---- orientation: the vertical, then the yaw, about the point under the camera ----
   // Turning about the user keeps where the user stands on the staircase (what is counted) and lets
@@ -276,8 +283,8 @@ void TraversalTracker::grow(Model& m) const {
 }
 
 const TraversalResult& TraversalTracker::update(const SceneResult& scene, const StairResult& stair,
-                                                const Pose& T_world_camera, bool pose_trusted, double timestamp,
-                                                std::uint64_t track) {
+                                                const Pose& T_world_camera, bool pose_trusted,
+                                                double timestamp, std::uint64_t track) {
   const auto t0 = std::chrono::steady_clock::now();
   out_ = TraversalResult{};
   out_.ran = cfg_.enabled;
@@ -306,7 +313,8 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
   // ---- this frame's detection ----
   // A single step or a curb is what the end of a flight looks like from its last steps (the last
   // riser and the landing, the last drop to the floor): it corrects a staircase held, never starts one.
-  const bool det = stair.detected && (is_flight(stair.kind) || (model_.valid && stair.kind != StairKind::kNone)) &&
+  const bool det = stair.detected &&
+                   (is_flight(stair.kind) || (model_.valid && stair.kind != StairKind::kNone)) &&
                    stair.direction() != 0 && stair.levels >= 1 && stair.riser_m > 0.f &&
                    stair.origin().norm() <= cfg_.max_distance;
   if (det) {
@@ -341,7 +349,8 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
     used = true;
   } else if (det && !stair.without_floor && is_flight(stair.kind)) {
     // A staircase not (or no longer) held: confirmed over a few frames before it is taken.
-    if (candidate_.valid && now - candidate_.last_seen <= cfg_.confirm_window && associate(candidate_, stair, T_wc)) {
+    if (candidate_.valid && now - candidate_.last_seen <= cfg_.confirm_window &&
+        associate(candidate_, stair, T_wc)) {
       correct(candidate_, quality, true);
       fuse_dimensions(candidate_, stair, quality);
       grow(candidate_);
@@ -354,7 +363,8 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
     } else {
       candidate_.valid = false;
     }
-    const bool replace = !model_.valid || (now - model_.last_seen > cfg_.lost_time && body_along(model_) < 0.f);
+    const bool replace =
+        !model_.valid || (now - model_.last_seen > cfg_.lost_time && body_along(model_) < 0.f);
     if (candidate_.valid && candidate_.hits >= cfg_.confirm_frames && replace) {
       model_ = candidate_;
       candidate_.valid = false;
@@ -427,7 +437,8 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
     out_.state = TraversalState::kArrived;
     if (now - arrived_at_ >= cfg_.arrive_hold) drop = true;
   } else if (step >= 1) {
-    out_.state = (m.last_known && step >= m.last_step - 1) ? TraversalState::kLastStep : TraversalState::kOnStairs;
+    out_.state =
+        (m.last_known && step >= m.last_step - 1) ? TraversalState::kLastStep : TraversalState::kOnStairs;
     if (m.last_known && step == m.last_step &&
         along >= edge_position(1, m.last_step, t) + cfg_.arrive_margin) {
       out_.state = TraversalState::kArrived;

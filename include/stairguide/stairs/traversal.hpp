@@ -42,8 +42,9 @@ class TraversalTracker {
   /// camera is taken to be where it was on the last frame and the live view alone corrects the
   /// staircase. `track` changes whenever the odometry's world is a new one (tracking restarted):
   /// the staircase is carried into it through the last camera pose.
-  const TraversalResult& update(const SceneResult& scene, const StairResult& stair, const Pose& T_world_camera,
-                                bool pose_trusted, double timestamp, std::uint64_t track = 0);
+  const TraversalResult& update(const SceneResult& scene, const StairResult& stair,
+                                const Pose& T_world_camera, bool pose_trusted, double timestamp,
+                                std::uint64_t track = 0);
 
   /// Forgets the staircase (and the memory): searching from nothing.
   void reset();
@@ -104,7 +105,8 @@ class TraversalTracker {
   std::vector<std::pair<float, int>> near_;  // squared distance to the camera, index into match_
   Eigen::Vector3f det_up_ = Eigen::Vector3f::UnitY(), det_forward_ = Eigen::Vector3f::UnitZ();  // world
   bool remembered_ = false;
-  bool floor_seen_ = false, origin_level_ = false;  // this frame: the floor found; the origin is a measured edge
+  bool floor_seen_ = false,
+       origin_level_ = false;  // this frame: the floor found; the origin is a measured edge
   Eigen::Vector3f pivot_ = Eigen::Vector3f::Zero();  // world, what the orientation correction turns about
   Pose T_world_camera_last_ = Pose::Identity();
   bool have_last_ = false;

@@ -35,14 +35,16 @@ int bench_traversal(Context& ctx) {
   ctx.positionals(0, 0);
   if (walks.empty()) walks = {"climb_8_steps", "descend_8_steps"};
   for (const auto& w : walks)
-    if (!synth::find_preset_info(w)) throw UsageError("unknown walk '" + w + "' (see 'stairguide synth --list')");
+    if (!synth::find_preset_info(w))
+      throw UsageError("unknown walk '" + w + "' (see 'stairguide synth --list')");
 
   std::vector<double> tracker_ms, stairs_ms;
   int frames = 0, on_stairs = 0;
   for (const auto& w : walks) {
     synth::SynthOptions opt;
     opt.fps = fps;
-    const long n = static_cast<long>(static_cast<double>(synth::find_preset_info(w)->default_frames) * fps / 30.0);
+    const long n =
+        static_cast<long>(static_cast<double>(synth::find_preset_info(w)->default_frames) * fps / 30.0);
     auto source = synth::make_source(w, n, seed, opt);
     Perception perception(ctx.config);
     StairStage stage(ctx.config);
@@ -70,13 +72,15 @@ int bench_traversal(Context& ctx) {
   const double med = percentile(tracker_ms, 0.5), p95 = percentile(tracker_ms, 0.95);
   const double rmed = percentile(stairs_ms, 0.5);
   if (json) {
-    std::printf("{\"median_ms\": %.4f, \"p95_ms\": %.4f, \"max_ms\": %.4f, \"frames\": %d, \"frames_on_stairs\": %d, "
-                "\"reference_median_ms\": %.4f, \"reference\": \"stairs stage\", \"ratio\": %.3f, \"goal_ms\": 1.0}\n",
-                med, p95, percentile(tracker_ms, 1.0), frames, on_stairs, rmed, med > 0 ? rmed / med : 0.0);
+    std::printf(
+        "{\"median_ms\": %.4f, \"p95_ms\": %.4f, \"max_ms\": %.4f, \"frames\": %d, \"frames_on_stairs\": %d, "
+        "\"reference_median_ms\": %.4f, \"reference\": \"stairs stage\", \"ratio\": %.3f, \"goal_ms\": "
+        "1.0}\n",
+        med, p95, percentile(tracker_ms, 1.0), frames, on_stairs, rmed, med > 0 ? rmed / med : 0.0);
     return 0;
   }
-  std::printf("traversal tracker, %d frames of %zu walk(s) at %.0f Hz (%d on the flight), thread CPU time\n", frames,
-              walks.size(), fps, on_stairs);
+  std::printf("traversal tracker, %d frames of %zu walk(s) at %.0f Hz (%d on the flight), thread CPU time\n",
+              frames, walks.size(), fps, on_stairs);
   std::printf("  tracker:   median %.4f ms  p95 %.4f ms  max %.4f ms  (goal: median <= 1 ms)\n", med, p95,
               percentile(tracker_ms, 1.0));
   std::printf("  reference: stairs stage on the same frames, median %.3f ms (%.0fx the tracker)\n", rmed,

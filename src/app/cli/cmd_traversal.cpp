@@ -40,11 +40,14 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 void parse_drift(const std::string& s, float& scale, float& yaw_rate) {
   char* end = nullptr;
   const double a = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != ',') throw UsageError("--drift '" + s + "': expected SCALE_PERCENT,YAW_DEG_PER_S");
+  if (end == s.c_str() || *end != ',')
+    throw UsageError("--drift '" + s + "': expected SCALE_PERCENT,YAW_DEG_PER_S");
   const char* b0 = end + 1;
   const double b = std::strtod(b0, &end);
-  if (end == b0 || *end != '\0' || !std::isfinite(a) || !std::isfinite(b) || std::fabs(a) > 50 || std::fabs(b) > 90)
-    throw UsageError("--drift '" + s + "': expected SCALE_PERCENT,YAW_DEG_PER_S (|scale| <= 50, |yaw| <= 90)");
+  if (end == b0 || *end != '\0' || !std::isfinite(a) || !std::isfinite(b) || std::fabs(a) > 50 ||
+      std::fabs(b) > 90)
+    throw UsageError("--drift '" + s +
+                     "': expected SCALE_PERCENT,YAW_DEG_PER_S (|scale| <= 50, |yaw| <= 90)");
   scale = static_cast<float>(a / 100.0);
   yaw_rate = static_cast<float>(b * M_PI / 180.0);
 }
@@ -105,8 +108,8 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
   // The gap in z_S the moment each step is reached (needs the truth).
   const int base = H - 30, top = plot_h + 30;
   cv::line(img, cv::Point(40, base), cv::Point(W - 20, base), cv::Scalar(0, 0, 0), 1);
-  cv::putText(img, "gap along z_S at each step (cm, 0-20): green corrected, red odometry only", cv::Point(10, plot_h + 15),
-              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, "gap along z_S at each step (cm, 0-20): green corrected, red odometry only",
+              cv::Point(10, plot_h + 15), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
   std::vector<bool> done(static_cast<std::size_t>(std::max(steps, 0) + 1), false);
   const int bw = steps > 0 ? std::max(4, (W - 80) / (2 * steps + 1)) : 10;
   for (const Sample& p : s) {
@@ -115,7 +118,8 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
     const int x = 40 + (2 * p.t_step - 2) * bw;
     auto bar = [&](float gap, int dx, const cv::Scalar& col) {
       if (!std::isfinite(gap)) return;
-      const int h = std::min(base - top, static_cast<int>(std::fabs(gap) * 100.f / 20.f * static_cast<float>(base - top)));
+      const int h = std::min(
+          base - top, static_cast<int>(std::fabs(gap) * 100.f / 20.f * static_cast<float>(base - top)));
       cv::rectangle(img, cv::Point(x + dx, base - h), cv::Point(x + dx + bw / 2, base), col, cv::FILLED);
     };
     bar(p.cam_z - p.t_cam_z, 0, cv::Scalar(0, 160, 0));
@@ -137,7 +141,8 @@ int replay(Context& ctx) {
   auto src = open_frame_source(pos[0], ctx.config.capture);
   std::ofstream jl(*out + "/frames.jsonl"), traj(*out + "/trajectory.txt");
   if (!jl || !traj) throw std::runtime_error(*out + ": cannot write frames.jsonl / trajectory.txt");
-  traj << "# timestamp tx ty tz qx qy qz qw (stairguide replay: DenseOdometry" << (drift_scale != 0 || drift_yaw != 0 ? ", drift injected" : "") << ")\n";
+  traj << "# timestamp tx ty tz qx qy qz qw (stairguide replay: DenseOdometry"
+       << (drift_scale != 0 || drift_yaw != 0 ? ", drift injected" : "") << ")\n";
 
   DenseOdometry odo;
   odo.configure(ctx.config.odometry, src->intrinsics());
@@ -171,8 +176,9 @@ int replay(Context& ctx) {
     perception.process(f, scene);
     const double ms_perc = ms_since(t0);
     if (!have_up && scene.floor_found) {
-      up_world = (o.T_world_camera.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY())
-                     .normalized();
+      up_world =
+          (o.T_world_camera.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY())
+              .normalized();
       have_up = true;
     }
     if (drift_scale != 0.f || drift_yaw != 0.f) {
@@ -180,9 +186,10 @@ int replay(Context& ctx) {
       const Eigen::Matrix3f Rz =
           Eigen::AngleAxisf(drift_yaw * static_cast<float>(f.timestamp), up_world).toRotationMatrix();
       const Eigen::Vector3f p =
-          have_raw ? Eigen::Vector3f(drifted.translation() + Rz * ((1.f + drift_scale) *
-                                                                  (T_wc.translation() - last_raw.translation())))
-                   : T_wc.translation();
+          have_raw
+              ? Eigen::Vector3f(drifted.translation() +
+                                Rz * ((1.f + drift_scale) * (T_wc.translation() - last_raw.translation())))
+              : T_wc.translation();
       last_raw = T_wc;
       have_raw = true;
       drifted.linear() = Rz * T_wc.linear();
@@ -219,32 +226,36 @@ int replay(Context& ctx) {
     samples.push_back(sm);
     const Eigen::Quaternionf q(T_wc.linear());
     char tl[200];
-    std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", f.timestamp, T_wc.translation().x(),
-                  T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(), q.w());
+    std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", f.timestamp,
+                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(),
+                  q.w());
     traj << tl;
     auto num = [](double v) { return json_number(v); };
-    std::string line = "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(f.timestamp) +
-                       ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) + ", \"detected\": " +
-                       std::to_string(stair.detected ? 1 : 0) + ", \"kind\": " + json_quote(to_string(stair.kind)) +
-                       ", \"levels\": " + std::to_string(stair.levels) + ", \"det_riser_m\": " + num(stair.riser_m) +
-                       ", \"det_tread_m\": " + num(stair.tread_m) + ", \"state\": " + json_quote(to_string(r.state)) +
-                       ", \"step\": " + std::to_string(r.step_index) + ", \"left\": " + std::to_string(r.steps_left) +
-                       ", \"known\": " + std::to_string(r.steps_known) + ", \"last_known\": " +
-                       std::to_string(r.last_known ? 1 : 0) + ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) +
-                       ", \"distance_m\": " + num(r.distance_m) + ", \"riser_m\": " + num(r.riser_m) +
-                       ", \"tread_m\": " + num(r.tread_m) + ", \"width_m\": " + num(r.width_m) +
-                       ", \"corr_height_m\": " + num(r.corr_height_m) + ", \"corr_along_m\": " + num(r.corr_along_m) +
-                       ", \"corr_yaw_rad\": " + num(r.corr_yaw_rad) + ", \"has_model\": " +
-                       std::to_string(r.direction != 0 ? 1 : 0) + ", \"cam_y\": " + num(sm.cam_y) +
-                       ", \"cam_z\": " + num(sm.cam_z) + ", \"u_state\": " + json_quote(to_string(u.state)) +
-                       ", \"u_step\": " + std::to_string(u.step_index) + ", \"u_has_model\": " +
-                       std::to_string(u.direction != 0 ? 1 : 0) + ", \"u_cam_y\": " + num(sm.u_cam_y) +
-                       ", \"u_cam_z\": " + num(sm.u_cam_z);
+    std::string line =
+        "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(f.timestamp) +
+        ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) +
+        ", \"detected\": " + std::to_string(stair.detected ? 1 : 0) +
+        ", \"kind\": " + json_quote(to_string(stair.kind)) + ", \"levels\": " + std::to_string(stair.levels) +
+        ", \"det_riser_m\": " + num(stair.riser_m) + ", \"det_tread_m\": " + num(stair.tread_m) +
+        ", \"state\": " + json_quote(to_string(r.state)) + ", \"step\": " + std::to_string(r.step_index) +
+        ", \"left\": " + std::to_string(r.steps_left) + ", \"known\": " + std::to_string(r.steps_known) +
+        ", \"last_known\": " + std::to_string(r.last_known ? 1 : 0) +
+        ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) + ", \"distance_m\": " + num(r.distance_m) +
+        ", \"riser_m\": " + num(r.riser_m) + ", \"tread_m\": " + num(r.tread_m) +
+        ", \"width_m\": " + num(r.width_m) + ", \"corr_height_m\": " + num(r.corr_height_m) +
+        ", \"corr_along_m\": " + num(r.corr_along_m) + ", \"corr_yaw_rad\": " + num(r.corr_yaw_rad) +
+        ", \"has_model\": " + std::to_string(r.direction != 0 ? 1 : 0) + ", \"cam_y\": " + num(sm.cam_y) +
+        ", \"cam_z\": " + num(sm.cam_z) + ", \"u_state\": " + json_quote(to_string(u.state)) +
+        ", \"u_step\": " + std::to_string(u.step_index) +
+        ", \"u_has_model\": " + std::to_string(u.direction != 0 ? 1 : 0) +
+        ", \"u_cam_y\": " + num(sm.u_cam_y) + ", \"u_cam_z\": " + num(sm.u_cam_z);
     if (st)
-      line += ", \"truth\": 1, \"t_step\": " + std::to_string(st->user_step) + ", \"t_steps\": " +
-              std::to_string(st->steps) + ", \"t_direction\": " + std::to_string(st->goes_down() ? -1 : 1) +
-              ", \"t_riser_m\": " + num(st->riser_m) + ", \"t_tread_m\": " + num(st->tread_m) + ", \"t_along\": " +
-              num(t_along) + ", \"t_cam_y\": " + num(sm.t_cam_y) + ", \"t_cam_z\": " + num(sm.t_cam_z);
+      line += ", \"truth\": 1, \"t_step\": " + std::to_string(st->user_step) +
+              ", \"t_steps\": " + std::to_string(st->steps) +
+              ", \"t_direction\": " + std::to_string(st->goes_down() ? -1 : 1) +
+              ", \"t_riser_m\": " + num(st->riser_m) + ", \"t_tread_m\": " + num(st->tread_m) +
+              ", \"t_along\": " + num(t_along) + ", \"t_cam_y\": " + num(sm.t_cam_y) +
+              ", \"t_cam_z\": " + num(sm.t_cam_z);
     else
       line += ", \"truth\": 0";
     line += ", \"ms_odometry\": " + num(ms_odo) + ", \"ms_perception\": " + num(ms_perc) +
@@ -297,7 +308,9 @@ int eval_traversal(Context& ctx) {
   std::vector<SeqScore> all;
   for (const std::string& d : dirs) {
     std::ifstream in(d + "/frames.jsonl");
-    if (!in) throw std::runtime_error(d + "/frames.jsonl: cannot read (make it with 'stairguide replay INPUT --out " + d + "')");
+    if (!in)
+      throw std::runtime_error(
+          d + "/frames.jsonl: cannot read (make it with 'stairguide replay INPUT --out " + d + "')");
     SeqScore s;
     std::vector<bool> gap_done;
     std::string line;
@@ -305,7 +318,8 @@ int eval_traversal(Context& ctx) {
     while (std::getline(in, line)) {
       ++lines;
       double v = 0;
-      if (!find_num(line, "frame", v)) throw std::runtime_error(d + "/frames.jsonl:" + std::to_string(lines) + ": not a replay frame line");
+      if (!find_num(line, "frame", v))
+        throw std::runtime_error(d + "/frames.jsonl:" + std::to_string(lines) + ": not a replay frame line");
       if (!find_num(line, "truth", v) || v == 0) continue;
       ++with_truth;
       double step = 0, t_step = 0, t_steps = 0, t_tread = 0, t_along = 0, known = 0, last_known = 0;
@@ -318,22 +332,24 @@ int eval_traversal(Context& ctx) {
       find_num(line, "last_known", last_known);
       const int N = static_cast<int>(t_steps);
       s.steps = N;
-      if (gap_done.size() != static_cast<std::size_t>(N + 1)) gap_done.assign(static_cast<std::size_t>(N + 1), false);
+      if (gap_done.size() != static_cast<std::size_t>(N + 1))
+        gap_done.assign(static_cast<std::size_t>(N + 1), false);
       const std::string state = find_str(line, "state");
       if (t_step >= 1 && t_along < (N - 1) * t_tread + 0.2) {
         ++s.frames_on_stairs;
         s.right += static_cast<int>(step) == static_cast<int>(t_step);
       }
       if (step > N || known > N) ++s.phantom;
-      if (state == "on_stairs" || state == "last_step" || state == "arrived") s.climbed = std::max(s.climbed, static_cast<int>(step));
+      if (state == "on_stairs" || state == "last_step" || state == "arrived")
+        s.climbed = std::max(s.climbed, static_cast<int>(step));
       if (state == "last_step" && t_step < N) s.missed_last = false;
       const int k = static_cast<int>(t_step);
       if (k >= 1 && k <= N && !gap_done[static_cast<std::size_t>(k)]) {
         double cy, cz, uy, uz, ty, tz, hm = 0, uhm = 0;
         find_num(line, "has_model", hm);
         find_num(line, "u_has_model", uhm);
-        if (hm > 0 && find_num(line, "cam_y", cy) && find_num(line, "cam_z", cz) && find_num(line, "t_cam_y", ty) &&
-            find_num(line, "t_cam_z", tz)) {
+        if (hm > 0 && find_num(line, "cam_y", cy) && find_num(line, "cam_z", cz) &&
+            find_num(line, "t_cam_y", ty) && find_num(line, "t_cam_z", tz)) {
           gap_done[static_cast<std::size_t>(k)] = true;
           s.gap_c = std::max(s.gap_c, std::max(std::fabs(cy - ty), std::fabs(cz - tz)));
           if (uhm > 0 && find_num(line, "u_cam_y", uy) && find_num(line, "u_cam_z", uz))
@@ -349,11 +365,13 @@ int eval_traversal(Context& ctx) {
       find_num(line, "tread_m", t);
       find_num(line, "t_riser_m", tr);
       if (det > 0 && in_view > 0 && dr > 0 && dt > 0) {
-        s.sr += std::fabs(dr - tr), s.st += std::fabs(dt - t_tread), s.fr += std::fabs(r - tr), s.ft += std::fabs(t - t_tread);
+        s.sr += std::fabs(dr - tr), s.st += std::fabs(dt - t_tread), s.fr += std::fabs(r - tr),
+            s.ft += std::fabs(t - t_tread);
         ++s.nf;
       }
     }
-    if (with_truth == 0) throw std::runtime_error(d + "/frames.jsonl: no frame carries a truth to score against");
+    if (with_truth == 0)
+      throw std::runtime_error(d + "/frames.jsonl: no frame carries a truth to score against");
     s.count_exact = s.climbed == s.steps;
     all.push_back(s);
   }
@@ -368,36 +386,41 @@ int eval_traversal(Context& ctx) {
   const double nf = std::max(1, tot.nf);
   const double acc = tot.frames_on_stairs ? static_cast<double>(tot.right) / tot.frames_on_stairs : 0.0;
   if (json) {
-    std::printf("{\"sequences\": %zu, \"frames_on_stairs\": %d, \"step_index_accuracy\": %s, \"count_exact\": %d, "
-                "\"phantom_steps\": %d, \"missed_last_step\": %d, \"gap_corrected_max_m\": %s, "
-                "\"gap_uncorrected_max_m\": %s, \"fused_riser_err_m\": %s, \"fused_tread_err_m\": %s, "
-                "\"single_frame_riser_err_m\": %s, \"single_frame_tread_err_m\": %s}\n",
-                all.size(), tot.frames_on_stairs, json_number(acc).c_str(), exact, tot.phantom, missed,
-                json_number(tot.gap_c).c_str(), json_number(tot.gap_u).c_str(), json_number(tot.fr / nf).c_str(),
-                json_number(tot.ft / nf).c_str(), json_number(tot.sr / nf).c_str(), json_number(tot.st / nf).c_str());
+    std::printf(
+        "{\"sequences\": %zu, \"frames_on_stairs\": %d, \"step_index_accuracy\": %s, \"count_exact\": %d, "
+        "\"phantom_steps\": %d, \"missed_last_step\": %d, \"gap_corrected_max_m\": %s, "
+        "\"gap_uncorrected_max_m\": %s, \"fused_riser_err_m\": %s, \"fused_tread_err_m\": %s, "
+        "\"single_frame_riser_err_m\": %s, \"single_frame_tread_err_m\": %s}\n",
+        all.size(), tot.frames_on_stairs, json_number(acc).c_str(), exact, tot.phantom, missed,
+        json_number(tot.gap_c).c_str(), json_number(tot.gap_u).c_str(), json_number(tot.fr / nf).c_str(),
+        json_number(tot.ft / nf).c_str(), json_number(tot.sr / nf).c_str(), json_number(tot.st / nf).c_str());
     return 0;
   }
   for (std::size_t i = 0; i < all.size(); ++i) {
     const SeqScore& s = all[i];
-    std::printf("%s: %d steps, step right %d/%d, climbed %d (%s), phantom frames %d, last step %s, gap max %.1f cm "
-                "(odometry only %.1f cm)\n",
-                dirs[i].c_str(), s.steps, s.right, s.frames_on_stairs, s.climbed, s.count_exact ? "exact" : "WRONG",
-                s.phantom, s.missed_last ? "MISSED" : "announced before it", 100 * s.gap_c, 100 * s.gap_u);
+    std::printf(
+        "%s: %d steps, step right %d/%d, climbed %d (%s), phantom frames %d, last step %s, gap max %.1f cm "
+        "(odometry only %.1f cm)\n",
+        dirs[i].c_str(), s.steps, s.right, s.frames_on_stairs, s.climbed, s.count_exact ? "exact" : "WRONG",
+        s.phantom, s.missed_last ? "MISSED" : "announced before it", 100 * s.gap_c, 100 * s.gap_u);
   }
-  std::printf("%zu sequences: step index right on %.2f%% of %d frames on the flight, count exact %d, phantom %d, "
-              "last step missed %d, gap max %.1f cm corrected / %.1f cm odometry only, riser err fused %.2f / single "
-              "%.2f cm, tread err fused %.2f / single %.2f cm\n",
-              all.size(), 100 * acc, tot.frames_on_stairs, exact, tot.phantom, missed, 100 * tot.gap_c, 100 * tot.gap_u,
-              100 * tot.fr / nf, 100 * tot.sr / nf, 100 * tot.ft / nf, 100 * tot.st / nf);
+  std::printf(
+      "%zu sequences: step index right on %.2f%% of %d frames on the flight, count exact %d, phantom %d, "
+      "last step missed %d, gap max %.1f cm corrected / %.1f cm odometry only, riser err fused %.2f / single "
+      "%.2f cm, tread err fused %.2f / single %.2f cm\n",
+      all.size(), 100 * acc, tot.frames_on_stairs, exact, tot.phantom, missed, 100 * tot.gap_c,
+      100 * tot.gap_u, 100 * tot.fr / nf, 100 * tot.sr / nf, 100 * tot.ft / nf, 100 * tot.st / nf);
   return 0;
 }
 
 }  // namespace
 
 SG_COMMAND("replay", "replay INPUT --out DIR [--frames N] [--drift SCALE_PERCENT,YAW_DEG_PER_S]",
-           "odometry, perception, stairs and traversal in order; frames.jsonl, trajectory.txt, traversal.png", replay);
+           "odometry, perception, stairs and traversal in order; frames.jsonl, trajectory.txt, traversal.png",
+           replay);
 SG_COMMAND("eval-traversal", "eval-traversal DIR... [--json]",
-           "scores replay folders: step index, count, phantom and last steps, drift gap, fused vs single-frame model",
+           "scores replay folders: step index, count, phantom and last steps, drift gap, fused vs "
+           "single-frame model",
            eval_traversal);
 
 }  // namespace stairguide::cli
