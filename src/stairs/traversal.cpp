@@ -457,7 +457,13 @@ const TraversalResult& TraversalTracker::update(const SceneResult& scene, const 
     }
   }
   if (drop) {
-    if (arrived_at_ >= 0.0) out_.state = TraversalState::kSearching;
+    // Nothing held any more: the frame reads as searching from nothing.
+    const bool in_view = out_.in_view;
+    const float quality = out_.quality;
+    out_ = TraversalResult{};
+    out_.ran = true;
+    out_.in_view = in_view;
+    out_.quality = quality;
     model_ = Model{};
     candidate_ = Model{};
     arrived_at_ = -1.0;
