@@ -254,16 +254,17 @@ int main(int argc, char** argv) {
   if (replay && args.frame_lines) {
     std::printf(
         "summary frames=%llu odometry_frames=%llu odometry_lost=%llu perception_frames=%llu "
-        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s cues=%llu "
-        "cues_sounded=%llu cue_latency_p50_ms=%.2f cue_latency_p99_ms=%.2f last_cue=%s\n",
+        "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s traversal=%s "
+        "traversal_step=%d traversal_left=%d traversal_known=%d cues=%llu cues_sounded=%llu "
+        "cue_latency_p50_ms=%.2f cue_latency_p99_ms=%.2f last_cue=%s\n",
         static_cast<unsigned long long>(st.frames_captured),
         static_cast<unsigned long long>(st.odometry_frames),
         static_cast<unsigned long long>(st.odometry_frames_lost),
         static_cast<unsigned long long>(st.perception_frames),
         static_cast<unsigned long long>(st.perception_skipped), st.fps, st.latency_p50_ms, st.latency_p99_ms,
-        st.state.c_str(), static_cast<unsigned long long>(st.cues),
-        static_cast<unsigned long long>(st.cues_sounded), st.cue_latency_p50_ms, st.cue_latency_p99_ms,
-        st.last_cue.empty() ? "-" : st.last_cue.c_str());
+        st.state.c_str(), st.traversal_state.c_str(), st.traversal_step, st.traversal_left, st.traversal_known,
+        static_cast<unsigned long long>(st.cues), static_cast<unsigned long long>(st.cues_sounded),
+        st.cue_latency_p50_ms, st.cue_latency_p99_ms, st.last_cue.empty() ? "-" : st.last_cue.c_str());
   }
   std::fflush(stdout);
   spdlog::default_logger()->flush();

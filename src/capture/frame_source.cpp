@@ -38,10 +38,7 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
     throw SourceError("input '" + input +
                       "': expected synth:SCENE[:FRAMES[:SEED[:NOISE]]] (see 'stairguide synth --list')");
   long frames = -1;
-  for (const auto& p : synth::presets())
-    if (p.name == parts[1]) frames = p.default_frames;
-  for (const auto& p : synth::world_presets())
-    if (p.name == parts[1]) frames = p.default_frames;
+  if (const synth::PresetInfo* p = synth::find_preset_info(parts[1])) frames = p->default_frames;
   if (parts.size() >= 3 && !parts[2].empty()) frames = parse_count(parts[2], input, "FRAMES");
   if (frames == 0) throw SourceError("input '" + input + "': FRAMES must be at least 1");
   std::uint32_t seed = 1;

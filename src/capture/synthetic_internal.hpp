@@ -44,6 +44,8 @@ struct PresetDef {
 const std::vector<PresetDef>& preset_defs();
 // The world's stairs (synth::world_presets()), apart from preset_defs().
 const std::vector<PresetDef>& world_preset_defs();
+/// The traversal walks (synthetic.hpp: walk_presets()).
+const std::vector<PresetDef>& walk_defs();
 // nullptr when unknown.
 const PresetDef* find_preset(const std::string& name);
 std::uint64_t name_hash(const std::string& s);

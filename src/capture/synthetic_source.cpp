@@ -37,6 +37,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
     std::string known;
     for (const auto& p : detail::preset_defs()) known += (known.empty() ? "" : ", ") + p.info.name;
     for (const auto& p : detail::world_preset_defs()) known += ", " + p.info.name;
+    for (const auto& p : detail::walk_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -132,6 +133,22 @@ const std::vector<PresetInfo>& world_presets() {
     return v;
   }();
   return list;
+}
+
+const std::vector<PresetInfo>& walk_presets() {
+  static const std::vector<PresetInfo> list = [] {
+    std::vector<PresetInfo> v;
+    for (const auto& d : detail::walk_defs()) v.push_back(d.info);
+    return v;
+  }();
+  return list;
+}
+
+const PresetInfo* find_preset_info(const std::string& name) {
+  for (const auto* l : {&presets(), &world_presets(), &walk_presets()})
+    for (const auto& p : *l)
+      if (p.name == name) return &p;
+  return nullptr;
 }
 
 CameraIntrinsics synthetic_intrinsics(const SynthOptions& o) {

@@ -12,6 +12,7 @@
 #include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stairs.hpp"
+#include "stairguide/stairs/traversal.hpp"
 
 namespace stairguide::runtime {
 
@@ -105,16 +106,19 @@ std::string OdometryStage::describe() const { return "DenseOdometry"; }
 
 // ---------------------------------------------------------------------------------------------
 // Perception (segmentation, floor, Manhattan, classification) -> stairs (detection, modelling).
-// The odometry's pose of the same frame carries the Manhattan frame between views.
-// SEAM (traversal): the library has no traversal stage yet (paper 5.2: step counting with the
-// odometry pose).
+// The odometry's pose of the same frame carries the Manhattan frame between views and holds the
+// staircase in the world for the traversal tracker (paper 5.2).
 struct PerceptionStage::Impl {
-  explicit Impl(const PipelineConfig& c) : config(c), perception(c), stairs(c) {}
+  explicit Impl(const PipelineConfig& c) : config(c), perception(c), stairs(c), traversal(c.traversal) {}
   PipelineConfig config;
   Perception perception;
   StairStage stairs;
+  TraversalTracker traversal;
   SceneResult scene;
   StairResult stair;
+  // The odometry's answer for the frame being perceived (hold_and_carry asks it).
+  PoseAnswer pose_answer = PoseAnswer::kNever;
+  OdometryLink pose_link;
   // Views whose own Manhattan frame waits for the odometry's pose of their frame (oldest first).
   std::deque<std::pair<std::uint64_t, ManhattanSighting>> pending;
 };
@@ -126,6 +130,7 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   m.perception.process(frame, m.scene);
+  m.pose_answer = PoseAnswer::kNever;
   if (odometry) hold_and_carry(frame, seq, odometry);
   PerceptionOutput out;
   out.seq = frame.index;
@@ -139,6 +144,13 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   m.stairs.run(m.scene, &frame.intrinsics, m.stair);
   out.stair_detected = m.stair.detected;
   out.stair = summarize(m.stair);
+  // The tracker: the pose of this frame when the odometry has it; otherwise the tracker takes the
+  // camera to be where it was and lets the live view correct the staircase.
+  if (m.config.traversal.enabled) {
+    const bool trusted = odometry && m.pose_answer == PoseAnswer::kReady;
+    out.traversal = m.traversal.update(m.scene, m.stair, m.pose_link.T_world_camera, trusted, frame.timestamp,
+                                       m.pose_link.track);
+  }
   if (m.stair.detected) {
     out.state = to_string(m.stair.kind);
     out.levels = m.stair.levels;
@@ -184,8 +196,12 @@ void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, 
   const bool seen = m.scene.manhattan_found;
   const bool carry = !seen && m.scene.floor_found &&
                      (m.perception.can_carry_manhattan(frame.timestamp) || !m.pending.empty());
+  // A staircase held by the traversal tracker needs this frame's pose as much as a carried frame.
+  const bool traversing = m.config.traversal.enabled && m.traversal.holding();
   OdometryLink link;
-  const PoseAnswer a = odometry(seq, link, carry);
+  const PoseAnswer a = odometry(seq, link, carry || traversing);
+  m.pose_answer = a;
+  if (a == PoseAnswer::kReady) m.pose_link = link;
   if (a == PoseAnswer::kReady) {
     flush();  // the odometry has passed the views before this one
     m.perception.apply_odometry(link, frame.timestamp, m.scene);
@@ -201,7 +217,8 @@ void PerceptionStage::reconfigure(const PipelineConfig& config) {
 }
 bool PerceptionStage::available() const { return true; }
 std::string PerceptionStage::describe() const {
-  return "Perception+StairStage(traversal=none, seam: no traversal stage in the library)";
+  return impl_->config.traversal.enabled ? "Perception+StairStage+TraversalTracker"
+                                         : "Perception+StairStage(traversal disabled in the config)";
 }
 
 // Feedback: src/runtime/feedback_stage.cpp.

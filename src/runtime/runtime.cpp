@@ -122,13 +122,14 @@ std::string RuntimeStats::summary() const {
       buf, sizeof buf,
       "%s: %llu frames, %.1f fps, odometry %llu (failed %llu, lost %llu), perception %llu "
       "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, camera lost %llu, cfg %llu, "
-      "cues %llu (last %s)",
+      "traversal %s step %d left %d known %d, cues %llu (last %s)",
       state.c_str(), static_cast<unsigned long long>(frames_captured), fps,
       static_cast<unsigned long long>(odometry_frames), static_cast<unsigned long long>(odometry_failures),
       static_cast<unsigned long long>(odometry_frames_lost),
       static_cast<unsigned long long>(perception_frames), perception_fps,
       static_cast<unsigned long long>(perception_skipped), drop_pct, latency_p50_ms, latency_p99_ms,
       static_cast<unsigned long long>(camera_losses), static_cast<unsigned long long>(config_generation),
+      traversal_state.c_str(), traversal_step, traversal_left, traversal_known,
       static_cast<unsigned long long>(cues), last_cue.empty() ? "-" : last_cue.c_str());
   return buf;
 }
@@ -190,6 +191,7 @@ struct Runtime::Impl {
   LatencyHistogram latency, interval_latency;
   Clock::time_point first_capture{}, last_decision{};
   bool have_first = false, have_last = false;
+  TraversalResult last_traversal;  // of the last decision (stats_mutex)
 
   // ---- odometry poses by frame, odometry -> perception ----
   // Perception carries the Manhattan frame between views with the pose of the very frame it works
@@ -615,6 +617,7 @@ struct Runtime::Impl {
       interval_latency.add(lat);
       last_decision = now;
       have_last = true;
+      if (m.out.traversal.ran) last_traversal = m.out.traversal;
     }
     decisions.fetch_add(1);
     if (d.changed) spdlog::info("frame {}: state {} ({})", m.out.seq, d.state, m.out.detail);
@@ -653,11 +656,13 @@ struct Runtime::Impl {
     if (o) std::snprintf(oms, sizeof oms, "%.2f", o->out.ms);
     std::fprintf(
         opt.frame_out,
-        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s"
-        " cue=%s\n",
+        "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s "
+        "traversal=%s step=%d left=%d known=%d cue=%s\n",
         static_cast<unsigned long long>(seq), ts, odom.c_str(), p ? token(p->out.state).c_str() : "skipped",
         static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms,
         !p ? "-" : !p->out.manhattan_found ? "none" : p->out.manhattan_carried ? "carried" : "seen",
+        p && p->out.traversal.ran ? to_string(p->out.traversal.state) : "-", p ? p->out.traversal.step_index : 0,
+        p ? p->out.traversal.steps_left : -1, p ? p->out.traversal.steps_known : 0,
         p && !p->cue.empty() ? p->cue.c_str() : "-");
     std::fflush(opt.frame_out);
   }
@@ -845,6 +850,12 @@ struct Runtime::Impl {
     s.cue_latency_p99_ms = cl.p99_ms;
     s.last_cue = cl.last;
     if (have_first && have_last) s.elapsed_s = std::max(0.0, seconds_between(first_capture, last_decision));
+    if (last_traversal.ran) {
+      s.traversal_state = to_string(last_traversal.state);
+      s.traversal_step = last_traversal.step_index;
+      s.traversal_left = last_traversal.steps_left;
+      s.traversal_known = last_traversal.steps_known;
+    }
     if (s.elapsed_s > 0) {
       s.fps = static_cast<double>(s.odometry_frames) / s.elapsed_s;
       s.perception_fps = static_cast<double>(s.perception_frames) / s.elapsed_s;

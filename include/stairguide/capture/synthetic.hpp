@@ -34,6 +34,14 @@ const std::vector<PresetInfo>& presets();
 /// presets(): the suites' figures rest on those draws. Every synth: input and make_source take
 /// their names.
 const std::vector<PresetInfo>& world_presets();
+/// The traversal walks (issue 32): climbs and descents of 3, 8 and 14 steps onto a landing, one
+/// pausing and turning on the flight, one past a person on it, each frame's truth giving the step
+/// under the body (StairTruth::user_step). Every name that climbs says "climb", every one that goes
+/// down "descen". Kept out of presets() so the suites that run every preset keep their figures;
+/// make_source() and build_preset_frame() know them.
+const std::vector<PresetInfo>& walk_presets();
+/// A preset or walk by name; nullptr when there is none.
+const PresetInfo* find_preset_info(const std::string& name);
 
 /// Sensor and trajectory options common to every preset.
 struct SynthOptions {

@@ -505,6 +505,73 @@ struct StairModellingConfig {
   }
 };
 
+/// The stair traversal tracker (stairs/traversal.hpp, paper 5.2): the staircase held in the
+/// odometry's world, corrected from the live view, and the step the user stands on.
+struct TraversalConfig {
+  bool enabled = true;             ///< run the tracker (false: traversal.ran stays false)
+  float body_behind = 0.12f;       ///< m, the body centre behind the chest camera (horizontally)
+  float body_below = 1.3f;         ///< m, the feet below the camera when no floor has measured it
+  float max_distance = 5.0f;       ///< m, a staircase farther than this is not tracked
+  int confirm_frames = 3;          ///< consistent detections needed to take a staircase
+  float confirm_window = 0.6f;     ///< s, ... each within this of the previous one
+  float lost_time = 2.0f;          ///< s unseen before the foot, after which the staircase is no longer "ahead"
+  float memory_time = 30.0f;       ///< s a staircase out of view is remembered in the world
+  float landing_factor = 1.8f;     ///< a tread this many goings deep is the last one (landing, floor)
+  float correction_gain = 0.15f;   ///< share of the live view's residual applied per frame (times its quality)
+  float tilt_gain = 0.25f;         ///< share of the correction gain given to the vertical (the odometry's tilt drifts little)
+  bool correct = true;             ///< correct the held pose from the live view (eq. 15); false: odometry only (eq. 14)
+  float match_fraction = 0.4f;     ///< a level matches a step within this share of the riser (height) and tread (edge)
+  float max_yaw_disagreement = 0.34906585f;  ///< rad, a detection further than this from the model's axes is another staircase (20 deg)
+  float max_riser_disagreement = 0.01f;   ///< m, a view whose riser differs more from the fused one is not used
+  float max_tread_disagreement = 0.03f;   ///< m, ... whose tread differs more
+  float max_tilt_disagreement = 0.034906585f;  ///< rad, ... whose vertical differs more from the held one (2 deg)
+  int near_levels = 3;             ///< the levels nearest the user whose residuals correct the pose (median)
+  float arrive_margin = 0.25f;     ///< m past the last edge at which the user has arrived
+  float arrive_hold = 1.5f;        ///< s the arrival is reported before searching again
+  float default_tread = 0.29f;     ///< m, going assumed until one is measured (one level seen)
+
+  template <class V> void visit(V& v) {
+    v.flag(enabled, "enabled", "run the traversal tracker (which step, how many left, the last one)");
+    v.num(body_behind, "body_behind_cm", Unit::kCentimetre, 0, 100,
+          "the body centre (what stands on a step) behind the chest camera, horizontally");
+    v.num(body_below, "body_below_cm", Unit::kCentimetre, 30, 250,
+          "the feet below the camera when no floor has measured the camera height");
+    v.num(max_distance, "max_distance_m", Unit::kMetre, 0.5, 20, "a staircase farther than this is not tracked");
+    v.num(confirm_frames, "confirm_frames", Unit::kCount, 1, 100,
+          "consistent detections needed before a staircase is taken (no false alarm from one frame)");
+    v.num(confirm_window, "confirm_window_s", Unit::kSecond, 0.01, 10,
+          "a confirming detection must come within this of the previous one");
+    v.num(lost_time, "lost_time_s", Unit::kSecond, 0.1, 60,
+          "unseen this long with the user before its foot, the staircase is no longer ahead (it stays in memory)");
+    v.num(memory_time, "memory_time_s", Unit::kSecond, 0, 3600,
+          "a staircase out of view is remembered in the odometry's world this long");
+    v.num(landing_factor, "landing_factor", Unit::kNone, 1.1, 10,
+          "a tread this many goings deep is the last one (a landing or the floor beyond)");
+    v.num(correction_gain, "correction_gain_percent", Unit::kPercent, 0, 100,
+          "share of the live view's residual (height, along, yaw, vertical) applied each frame, times its quality");
+    v.num(tilt_gain, "tilt_gain_percent", Unit::kPercent, 0, 100,
+          "share of the correction gain applied to the vertical (the odometry's tilt drifts little; a view's vertical is noisy)");
+    v.flag(correct, "correct", "correct the odometry-held stair pose from the live view (paper eq. 15)");
+    v.num(match_fraction, "match_percent", Unit::kPercent, 5, 50,
+          "a seen level matches a step of the model within this share of the riser (height) and tread (edge)");
+    v.num(max_yaw_disagreement, "max_yaw_disagreement_deg", Unit::kDegree, 1, 90,
+          "a detection whose axes differ more than this from the held staircase's is another staircase");
+    v.num(max_riser_disagreement, "max_riser_disagreement_cm", Unit::kCentimetre, 0.1, 10,
+          "a view whose riser differs more than this from the fused riser does not correct the staircase");
+    v.num(max_tread_disagreement, "max_tread_disagreement_cm", Unit::kCentimetre, 0.1, 20,
+          "a view whose tread differs more than this from the fused tread does not correct the staircase");
+    v.num(max_tilt_disagreement, "max_tilt_disagreement_deg", Unit::kDegree, 0.1, 45,
+          "a view whose vertical differs more than this from the held staircase's does not correct it");
+    v.num(near_levels, "near_levels", Unit::kCount, 1, 50,
+          "the levels nearest the user whose height and edge residuals (their median) correct the held pose");
+    v.num(arrive_margin, "arrive_margin_cm", Unit::kCentimetre, 0, 200,
+          "the user has arrived this far past the last step edge");
+    v.num(arrive_hold, "arrive_hold_s", Unit::kSecond, 0, 60, "the arrival is reported this long, then searching again");
+    v.num(default_tread, "default_tread_cm", Unit::kCentimetre, 15, 60,
+          "going assumed until a tread length is measured (a single level seen)");
+  }
+};
+
 struct OdometryConfig {
   float sigma_intensity = 5.0f;     ///< intensity units (0-255), photometric residual scale
   float sigma_inv_depth = 0.0025f;  ///< 1/m, inverse-depth residual scale
@@ -625,6 +692,7 @@ struct PipelineConfig {
   ClassificationConfig classification;
   StairDetectionConfig stair_detection;
   StairModellingConfig stair_modelling;
+  TraversalConfig traversal;
   OdometryConfig odometry;
   RuntimeConfig runtime;
   FeedbackConfig feedback;
@@ -637,6 +705,7 @@ struct PipelineConfig {
     v.section("classification", "classification of regions (paper 3.3)", classification);
     v.section("stair_detection", "stair detection (paper 4.1)", stair_detection);
     v.section("stair_modelling", "stair modelling and validation (paper 4.2)", stair_modelling);
+    v.section("traversal", "stair traversal: the step the user is on, steps left (paper 5.2)", traversal);
     v.section("odometry", "dense RGB-D visual odometry (paper 5.1)", odometry);
     v.section("runtime", "daemon threads, logging and counters", runtime);
     v.section("feedback", "audio cues and haptic buzzer", feedback);

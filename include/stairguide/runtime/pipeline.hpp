@@ -56,7 +56,7 @@ struct PerceptionOutput {
   float manhattan_yaw = 0.f;  ///< rad, k_M from the floor frame's forward axis
   /// The typed results: what the feedback room reads (as numbers, not from `detail`).
   StairSummary stair;
-  TraversalResult traversal;  ///< `ran` false while the library has no traversal stage
+  TraversalResult traversal;  ///< the traversal tracker (stairs/traversal.hpp); `ran` false when traversal.enabled is off
   double ms = 0.0;     ///< time spent in the stages
 };
 

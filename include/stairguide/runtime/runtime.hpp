@@ -80,6 +80,10 @@ struct RuntimeStats {
   double cue_latency_p50_ms = 0.0; ///< capture of the frame warranting a cue -> its first sample out
   double cue_latency_p99_ms = 0.0;
   std::string last_cue;            ///< token of the last cue ("" none)
+  /// The traversal as of the last decision (issue 32): state token, step the user stands on,
+  /// steps left (-1 unknown), steps known.
+  std::string traversal_state = "-";
+  int traversal_step = 0, traversal_left = -1, traversal_known = 0;
   /// The systemd STATUS= text / log line for these counters.
   std::string summary() const;
 };

@@ -74,6 +74,12 @@ struct TraversalResult {
   float corr_height_m = 0.f, corr_along_m = 0.f, corr_yaw_rad = 0.f;
   bool corrected = false;  ///< a correction was applied this frame
   double ms = 0.0;         ///< time spent in the tracker
+  // Added by issue 32 (the tracker's own view, for replays and evaluation):
+  /// m, the body centre in the stair frame: along z_S (from the first edge) and height along y_S
+  /// (the feet, same origin as the stair frame); NaN while no staircase is held.
+  float body_along_m = std::numeric_limits<float>::quiet_NaN();
+  float body_height_m = std::numeric_limits<float>::quiet_NaN();
+  float quality = 0.f;  ///< 0..1, weight of this frame's view in the fused model (0: not used)
 };
 
 }  // namespace stairguide

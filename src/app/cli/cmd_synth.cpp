@@ -23,22 +23,17 @@ int synth_cmd(Context& ctx) {
   const auto oni = ctx.option("--oni");
   ctx.positionals(0, 0);
   if (list) {
-    for (const auto& p : synth::presets())
-      std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
-    for (const auto& p : synth::world_presets())
-      std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
+    for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets()})
+      for (const auto& p : *l) std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
     return 0;
   }
   if (!scene) throw UsageError("--scene NAME is required (see --list)");
   if (!out) throw UsageError("--out DIR is required");
-  const synth::PresetInfo* preset = nullptr;
-  for (const auto& p : synth::presets())
-    if (p.name == *scene) preset = &p;
-  for (const auto& p : synth::world_presets())
-    if (p.name == *scene) preset = &p;
+  const synth::PresetInfo* preset = synth::find_preset_info(*scene);
   if (!preset) {
     std::string names;
-    for (const auto& p : synth::presets()) names += (names.empty() ? "" : ", ") + p.name;
+    for (const auto* l : {&synth::presets(), &synth::walk_presets()})
+      for (const auto& p : *l) names += (names.empty() ? "" : ", ") + p.name;
     throw UsageError("unknown scene '" + *scene + "' (known: " + names + ")");
   }
   const long frames = frames_opt ? *frames_opt : preset->default_frames;

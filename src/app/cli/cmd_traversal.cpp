@@ -1,0 +1,426 @@
+// Traversal commands (issue 32):
+//   stairguide replay INPUT --out DIR [--frames N] [--drift SCALE_PERCENT,YAW_DEG_PER_S]
+//   stairguide eval-traversal DIR... [--json]
+// replay runs the daemon's stages in order on one thread, as fast as they go (our DenseOdometry,
+// perception, the stairs stage and the traversal tracker, plus a second tracker held by the
+// odometry alone for comparison) and writes frames.jsonl (a line per frame), trajectory.txt (TUM)
+// and traversal.png (the camera's y_S-z_S path against the stair profile with and without the
+// correction, the paper's Fig. 19, and the gap at each step, Fig. 20). eval-traversal scores
+// those folders against the truth the input carried (synthetic walks, labelled datasets).
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "cli/command.hpp"
+#include "stairguide/capture/frame_source.hpp"
+#include "stairguide/core/json.hpp"
+#include "stairguide/odometry/dense_odometry.hpp"
+#include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stairs.hpp"
+#include "stairguide/stairs/traversal.hpp"
+
+namespace stairguide::cli {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// "2,1" -> 2 % scale error, 1 deg/s yaw.
+void parse_drift(const std::string& s, float& scale, float& yaw_rate) {
+  char* end = nullptr;
+  const double a = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != ',')
+    throw UsageError("--drift '" + s + "': expected SCALE_PERCENT,YAW_DEG_PER_S");
+  const char* b0 = end + 1;
+  const double b = std::strtod(b0, &end);
+  if (end == b0 || *end != '\0' || !std::isfinite(a) || !std::isfinite(b) || std::fabs(a) > 50 ||
+      std::fabs(b) > 90)
+    throw UsageError("--drift '" + s +
+                     "': expected SCALE_PERCENT,YAW_DEG_PER_S (|scale| <= 50, |yaw| <= 90)");
+  scale = static_cast<float>(a / 100.0);
+  yaw_rate = static_cast<float>(b * M_PI / 180.0);
+}
+
+struct Sample {
+  float cam_y = NAN, cam_z = NAN, u_cam_y = NAN, u_cam_z = NAN, t_cam_y = NAN, t_cam_z = NAN;
+  int t_step = -1;
+};
+
+void draw_png(const std::string& path, const std::vector<Sample>& s, const TraversalResult& model, int steps,
+              float riser, float tread, int direction) {
+  const int W = 900, H = 700, plot_h = 460;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  float zmin = -1.f, zmax = 1.f, ymin = -0.5f, ymax = 2.f;
+  for (const Sample& p : s)
+    for (const auto& q : {std::make_pair(p.cam_z, p.cam_y), std::make_pair(p.u_cam_z, p.u_cam_y),
+                          std::make_pair(p.t_cam_z, p.t_cam_y)})
+      if (std::isfinite(q.first) && std::isfinite(q.second)) {
+        zmin = std::min(zmin, q.first), zmax = std::max(zmax, q.first);
+        ymin = std::min(ymin, q.second), ymax = std::max(ymax, q.second);
+      }
+  const int n = std::max(steps, model.steps_known);
+  const float r = riser > 0 ? riser : model.riser_m, t = tread > 0 ? tread : model.tread_m;
+  ymin = std::min(ymin, direction < 0 ? -r * static_cast<float>(n) - 0.1f : -r - 0.1f);
+  const float sx = static_cast<float>(W - 80) / std::max(0.1f, zmax - zmin);
+  const float sy = static_cast<float>(plot_h - 60) / std::max(0.1f, ymax - ymin);
+  const float sc = std::min(sx, sy);
+  auto P = [&](float z, float y) {
+    return cv::Point(40 + static_cast<int>((z - zmin) * sc), plot_h - 30 - static_cast<int>((y - ymin) * sc));
+  };
+  // The stair profile (stair frame: ascending tread j at y = (j-1) r from z = (j-1) t).
+  std::vector<cv::Point> prof;
+  if (n > 0 && r > 0 && t > 0) {
+    float y = direction > 0 ? -r : 0.f;
+    prof.push_back(P(zmin, y));
+    for (int j = 1; j <= n; ++j) {
+      const float z = direction > 0 ? static_cast<float>(j - 1) * t : static_cast<float>(j - 1) * t;
+      prof.push_back(P(z, y));
+      y = direction > 0 ? static_cast<float>(j - 1) * r : -static_cast<float>(j) * r;
+      prof.push_back(P(z, y));
+    }
+    prof.push_back(P(zmax, y));
+    cv::polylines(img, prof, false, cv::Scalar(0, 0, 0), 2);
+  }
+  auto path_of = [&](auto get, const cv::Scalar& col) {
+    std::vector<cv::Point> pts;
+    for (const Sample& p : s) {
+      const auto [z, y] = get(p);
+      if (std::isfinite(z) && std::isfinite(y)) pts.push_back(P(z, y));
+    }
+    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2);
+  };
+  path_of([](const Sample& p) { return std::make_pair(p.t_cam_z, p.t_cam_y); }, cv::Scalar(200, 120, 0));
+  path_of([](const Sample& p) { return std::make_pair(p.u_cam_z, p.u_cam_y); }, cv::Scalar(0, 0, 220));
+  path_of([](const Sample& p) { return std::make_pair(p.cam_z, p.cam_y); }, cv::Scalar(0, 160, 0));
+  cv::putText(img, "camera y_S-z_S: green corrected, red odometry only, blue truth, black stair profile",
+              cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  // The gap in z_S the moment each step is reached (needs the truth).
+  const int base = H - 30, top = plot_h + 30;
+  cv::line(img, cv::Point(40, base), cv::Point(W - 20, base), cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, "gap along z_S at each step (cm, 0-20): green corrected, red odometry only",
+              cv::Point(10, plot_h + 15), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  std::vector<bool> done(static_cast<std::size_t>(std::max(steps, 0) + 1), false);
+  const int bw = steps > 0 ? std::max(4, (W - 80) / (2 * steps + 1)) : 10;
+  for (const Sample& p : s) {
+    if (p.t_step < 1 || p.t_step > steps || done[static_cast<std::size_t>(p.t_step)]) continue;
+    done[static_cast<std::size_t>(p.t_step)] = true;
+    const int x = 40 + (2 * p.t_step - 2) * bw;
+    auto bar = [&](float gap, int dx, const cv::Scalar& col) {
+      if (!std::isfinite(gap)) return;
+      const int h = std::min(
+          base - top, static_cast<int>(std::fabs(gap) * 100.f / 20.f * static_cast<float>(base - top)));
+      cv::rectangle(img, cv::Point(x + dx, base - h), cv::Point(x + dx + bw / 2, base), col, cv::FILLED);
+    };
+    bar(p.cam_z - p.t_cam_z, 0, cv::Scalar(0, 160, 0));
+    bar(p.u_cam_z - p.t_cam_z, bw / 2, cv::Scalar(0, 0, 220));
+  }
+  if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write the PNG");
+}
+
+int replay(Context& ctx) {
+  const auto out = ctx.option("--out");
+  const auto max_frames = ctx.int_option("--frames", 1, 100000000);
+  float drift_scale = 0.f, drift_yaw = 0.f;
+  if (const auto d = ctx.option("--drift")) parse_drift(*d, drift_scale, drift_yaw);
+  const auto pos = ctx.positionals(1, 1);
+  if (!out) throw UsageError("--out DIR is required");
+  std::error_code ec;
+  std::filesystem::create_directories(*out, ec);
+  if (ec) throw std::runtime_error(*out + ": cannot create the folder (" + ec.message() + ")");
+  auto src = open_frame_source(pos[0], ctx.config.capture);
+  std::ofstream jl(*out + "/frames.jsonl"), traj(*out + "/trajectory.txt");
+  if (!jl || !traj) throw std::runtime_error(*out + ": cannot write frames.jsonl / trajectory.txt");
+  traj << "# timestamp tx ty tz qx qy qz qw (stairguide replay: DenseOdometry"
+       << (drift_scale != 0 || drift_yaw != 0 ? ", drift injected" : "") << ")\n";
+
+  DenseOdometry odo;
+  odo.configure(ctx.config.odometry, src->intrinsics());
+  Perception perception(ctx.config);
+  StairStage stage(ctx.config);
+  TraversalTracker tracker(ctx.config.traversal);
+  TraversalConfig held_cfg = ctx.config.traversal;
+  held_cfg.correct = false;
+  TraversalTracker held(held_cfg);
+  RgbdFrame f;
+  SceneResult scene;
+  StairResult stair;
+  std::vector<Sample> samples;
+  TraversalResult last_model;
+  int steps = 0, direction = 1;
+  float riser = 0.f, tread = 0.f;
+  std::uint64_t track = 0;
+  Pose drifted = Pose::Identity(), last_raw = Pose::Identity();
+  Eigen::Vector3f up_world(0.f, -1.f, 0.f);
+  bool have_up = false, have_raw = false;
+  const bool tty = isatty(STDERR_FILENO);
+  const long total = src->frame_count();
+  long n = 0;
+  while ((!max_frames || n < *max_frames) && src->read(f).ok()) {
+    auto t0 = std::chrono::steady_clock::now();
+    const OdometryResult o = odo.track(f);
+    const double ms_odo = ms_since(t0);
+    if (!o.ok) ++track;
+    Pose T_wc = o.T_world_camera;
+    t0 = std::chrono::steady_clock::now();
+    perception.process(f, scene);
+    const double ms_perc = ms_since(t0);
+    if (!have_up && scene.floor_found) {
+      up_world =
+          (o.T_world_camera.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY())
+              .normalized();
+      have_up = true;
+    }
+    if (drift_scale != 0.f || drift_yaw != 0.f) {
+      // Every increment (1 + scale) long, the world turning yaw_rate * t about the vertical.
+      const Eigen::Matrix3f Rz =
+          Eigen::AngleAxisf(drift_yaw * static_cast<float>(f.timestamp), up_world).toRotationMatrix();
+      const Eigen::Vector3f p =
+          have_raw
+              ? Eigen::Vector3f(drifted.translation() +
+                                Rz * ((1.f + drift_scale) * (T_wc.translation() - last_raw.translation())))
+              : T_wc.translation();
+      last_raw = T_wc;
+      have_raw = true;
+      drifted.linear() = Rz * T_wc.linear();
+      drifted.translation() = p;
+      T_wc = drifted;
+    }
+    t0 = std::chrono::steady_clock::now();
+    stage.run(scene, f.intrinsics, stair);
+    const double ms_stairs = ms_since(t0);
+    const TraversalResult r = tracker.update(scene, stair, T_wc, o.ok, f.timestamp, track);
+    const TraversalResult u = held.update(scene, stair, T_wc, o.ok, f.timestamp, track);
+    if (r.direction != 0) last_model = r;
+    Sample sm;
+    if (r.direction != 0) {
+      const Eigen::Vector3f c = r.T_world_stair.inverse() * T_wc.translation();
+      sm.cam_y = c.y(), sm.cam_z = c.z();
+    }
+    if (u.direction != 0) {
+      const Eigen::Vector3f c = u.T_world_stair.inverse() * T_wc.translation();
+      sm.u_cam_y = c.y(), sm.u_cam_z = c.z();
+    }
+    const auto truth = src->truth();
+    const StairTruth* st = truth && !truth->stairs.empty() ? &truth->stairs[0] : nullptr;
+    float t_along = NAN;
+    if (st) {
+      const Pose T_sc = st->T_camera_stair.inverse();
+      Eigen::Vector3f fwd = T_sc.linear().col(2);
+      fwd.y() = 0.f;
+      t_along = (T_sc.translation() - ctx.config.traversal.body_behind * fwd.normalized()).z();
+      sm.t_cam_y = T_sc.translation().y(), sm.t_cam_z = T_sc.translation().z();
+      sm.t_step = st->user_step;
+      steps = st->steps, riser = st->riser_m, tread = st->tread_m, direction = st->goes_down() ? -1 : 1;
+    }
+    samples.push_back(sm);
+    const Eigen::Quaternionf q(T_wc.linear());
+    char tl[200];
+    std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", f.timestamp,
+                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(),
+                  q.w());
+    traj << tl;
+    auto num = [](double v) { return json_number(v); };
+    std::string line =
+        "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(f.timestamp) +
+        ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) +
+        ", \"detected\": " + std::to_string(stair.detected ? 1 : 0) +
+        ", \"kind\": " + json_quote(to_string(stair.kind)) + ", \"levels\": " + std::to_string(stair.levels) +
+        ", \"det_riser_m\": " + num(stair.riser_m) + ", \"det_tread_m\": " + num(stair.tread_m) +
+        ", \"state\": " + json_quote(to_string(r.state)) + ", \"step\": " + std::to_string(r.step_index) +
+        ", \"left\": " + std::to_string(r.steps_left) + ", \"known\": " + std::to_string(r.steps_known) +
+        ", \"last_known\": " + std::to_string(r.last_known ? 1 : 0) +
+        ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) + ", \"distance_m\": " + num(r.distance_m) +
+        ", \"riser_m\": " + num(r.riser_m) + ", \"tread_m\": " + num(r.tread_m) +
+        ", \"width_m\": " + num(r.width_m) + ", \"corr_height_m\": " + num(r.corr_height_m) +
+        ", \"corr_along_m\": " + num(r.corr_along_m) + ", \"corr_yaw_rad\": " + num(r.corr_yaw_rad) +
+        ", \"has_model\": " + std::to_string(r.direction != 0 ? 1 : 0) + ", \"cam_y\": " + num(sm.cam_y) +
+        ", \"cam_z\": " + num(sm.cam_z) + ", \"u_state\": " + json_quote(to_string(u.state)) +
+        ", \"u_step\": " + std::to_string(u.step_index) +
+        ", \"u_has_model\": " + std::to_string(u.direction != 0 ? 1 : 0) +
+        ", \"u_cam_y\": " + num(sm.u_cam_y) + ", \"u_cam_z\": " + num(sm.u_cam_z);
+    if (st)
+      line += ", \"truth\": 1, \"t_step\": " + std::to_string(st->user_step) +
+              ", \"t_steps\": " + std::to_string(st->steps) +
+              ", \"t_direction\": " + std::to_string(st->goes_down() ? -1 : 1) +
+              ", \"t_riser_m\": " + num(st->riser_m) + ", \"t_tread_m\": " + num(st->tread_m) +
+              ", \"t_along\": " + num(t_along) + ", \"t_cam_y\": " + num(sm.t_cam_y) +
+              ", \"t_cam_z\": " + num(sm.t_cam_z);
+    else
+      line += ", \"truth\": 0";
+    line += ", \"ms_odometry\": " + num(ms_odo) + ", \"ms_perception\": " + num(ms_perc) +
+            ", \"ms_stairs\": " + num(ms_stairs) + ", \"ms_traversal\": " + num(r.ms) + "}\n";
+    jl << line;
+    ++n;
+    if (tty && n % 10 == 0) {
+      if (total > 0)
+        std::fprintf(stderr, "\rreplay: frame %ld of %ld", n, total);
+      else
+        std::fprintf(stderr, "\rreplay: frame %ld", n);
+    }
+  }
+  if (tty) std::fprintf(stderr, "\n");
+  if (n == 0) throw std::runtime_error(pos[0] + ": no frame could be read");
+  draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
+  std::printf("replay: %ld frames -> %s/frames.jsonl, trajectory.txt, traversal.png\n", n, out->c_str());
+  return 0;
+}
+
+// ---- eval-traversal ----
+
+bool find_num(const std::string& line, const char* key, double& v) {
+  const std::string k = std::string("\"") + key + "\": ";
+  const std::size_t p = line.find(k);
+  if (p == std::string::npos) return false;
+  char* end = nullptr;
+  v = std::strtod(line.c_str() + p + k.size(), &end);
+  return end != line.c_str() + p + k.size();
+}
+std::string find_str(const std::string& line, const char* key) {
+  const std::string k = std::string("\"") + key + "\": \"";
+  const std::size_t p = line.find(k);
+  if (p == std::string::npos) return "";
+  const std::size_t e = line.find('"', p + k.size());
+  return line.substr(p + k.size(), e - p - k.size());
+}
+
+struct SeqScore {
+  int frames_on_stairs = 0, right = 0, phantom = 0, climbed = 0, steps = 0;
+  bool count_exact = false, missed_last = true;
+  double gap_c = 0, gap_u = 0;
+  double fr = 0, ft = 0, sr = 0, st = 0;
+  int nf = 0;
+};
+
+int eval_traversal(Context& ctx) {
+  const bool json = ctx.flag("--json");
+  const auto dirs = ctx.positionals(1, 1000);
+  std::vector<SeqScore> all;
+  for (const std::string& d : dirs) {
+    std::ifstream in(d + "/frames.jsonl");
+    if (!in)
+      throw std::runtime_error(
+          d + "/frames.jsonl: cannot read (make it with 'stairguide replay INPUT --out " + d + "')");
+    SeqScore s;
+    std::vector<bool> gap_done;
+    std::string line;
+    int lines = 0, with_truth = 0;
+    while (std::getline(in, line)) {
+      ++lines;
+      double v = 0;
+      if (!find_num(line, "frame", v))
+        throw std::runtime_error(d + "/frames.jsonl:" + std::to_string(lines) + ": not a replay frame line");
+      if (!find_num(line, "truth", v) || v == 0) continue;
+      ++with_truth;
+      double step = 0, t_step = 0, t_steps = 0, t_tread = 0, t_along = 0, known = 0, last_known = 0;
+      find_num(line, "step", step);
+      find_num(line, "t_step", t_step);
+      find_num(line, "t_steps", t_steps);
+      find_num(line, "t_tread_m", t_tread);
+      find_num(line, "t_along", t_along);
+      find_num(line, "known", known);
+      find_num(line, "last_known", last_known);
+      const int N = static_cast<int>(t_steps);
+      s.steps = N;
+      if (gap_done.size() != static_cast<std::size_t>(N + 1))
+        gap_done.assign(static_cast<std::size_t>(N + 1), false);
+      const std::string state = find_str(line, "state");
+      if (t_step >= 1 && t_along < (N - 1) * t_tread + 0.2) {
+        ++s.frames_on_stairs;
+        s.right += static_cast<int>(step) == static_cast<int>(t_step);
+      }
+      if (step > N || known > N) ++s.phantom;
+      if (state == "on_stairs" || state == "last_step" || state == "arrived")
+        s.climbed = std::max(s.climbed, static_cast<int>(step));
+      if (state == "last_step" && t_step < N) s.missed_last = false;
+      const int k = static_cast<int>(t_step);
+      if (k >= 1 && k <= N && !gap_done[static_cast<std::size_t>(k)]) {
+        double cy, cz, uy, uz, ty, tz, hm = 0, uhm = 0;
+        find_num(line, "has_model", hm);
+        find_num(line, "u_has_model", uhm);
+        if (hm > 0 && find_num(line, "cam_y", cy) && find_num(line, "cam_z", cz) &&
+            find_num(line, "t_cam_y", ty) && find_num(line, "t_cam_z", tz)) {
+          gap_done[static_cast<std::size_t>(k)] = true;
+          s.gap_c = std::max(s.gap_c, std::max(std::fabs(cy - ty), std::fabs(cz - tz)));
+          if (uhm > 0 && find_num(line, "u_cam_y", uy) && find_num(line, "u_cam_z", uz))
+            s.gap_u = std::max(s.gap_u, std::max(std::fabs(uy - ty), std::fabs(uz - tz)));
+        }
+      }
+      double det = 0, in_view = 0, dr = 0, dt = 0, r = 0, t = 0, tr = 0;
+      find_num(line, "detected", det);
+      find_num(line, "in_view", in_view);
+      find_num(line, "det_riser_m", dr);
+      find_num(line, "det_tread_m", dt);
+      find_num(line, "riser_m", r);
+      find_num(line, "tread_m", t);
+      find_num(line, "t_riser_m", tr);
+      if (det > 0 && in_view > 0 && dr > 0 && dt > 0) {
+        s.sr += std::fabs(dr - tr), s.st += std::fabs(dt - t_tread), s.fr += std::fabs(r - tr),
+            s.ft += std::fabs(t - t_tread);
+        ++s.nf;
+      }
+    }
+    if (with_truth == 0)
+      throw std::runtime_error(d + "/frames.jsonl: no frame carries a truth to score against");
+    s.count_exact = s.climbed == s.steps;
+    all.push_back(s);
+  }
+  SeqScore tot;
+  int exact = 0, missed = 0;
+  for (const SeqScore& s : all) {
+    tot.frames_on_stairs += s.frames_on_stairs, tot.right += s.right, tot.phantom += s.phantom;
+    exact += s.count_exact, missed += s.missed_last;
+    tot.gap_c = std::max(tot.gap_c, s.gap_c), tot.gap_u = std::max(tot.gap_u, s.gap_u);
+    tot.fr += s.fr, tot.ft += s.ft, tot.sr += s.sr, tot.st += s.st, tot.nf += s.nf;
+  }
+  const double nf = std::max(1, tot.nf);
+  const double acc = tot.frames_on_stairs ? static_cast<double>(tot.right) / tot.frames_on_stairs : 0.0;
+  if (json) {
+    std::printf(
+        "{\"sequences\": %zu, \"frames_on_stairs\": %d, \"step_index_accuracy\": %s, \"count_exact\": %d, "
+        "\"phantom_steps\": %d, \"missed_last_step\": %d, \"gap_corrected_max_m\": %s, "
+        "\"gap_uncorrected_max_m\": %s, \"fused_riser_err_m\": %s, \"fused_tread_err_m\": %s, "
+        "\"single_frame_riser_err_m\": %s, \"single_frame_tread_err_m\": %s}\n",
+        all.size(), tot.frames_on_stairs, json_number(acc).c_str(), exact, tot.phantom, missed,
+        json_number(tot.gap_c).c_str(), json_number(tot.gap_u).c_str(), json_number(tot.fr / nf).c_str(),
+        json_number(tot.ft / nf).c_str(), json_number(tot.sr / nf).c_str(), json_number(tot.st / nf).c_str());
+    return 0;
+  }
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const SeqScore& s = all[i];
+    std::printf(
+        "%s: %d steps, step right %d/%d, climbed %d (%s), phantom frames %d, last step %s, gap max %.1f cm "
+        "(odometry only %.1f cm)\n",
+        dirs[i].c_str(), s.steps, s.right, s.frames_on_stairs, s.climbed, s.count_exact ? "exact" : "WRONG",
+        s.phantom, s.missed_last ? "MISSED" : "announced before it", 100 * s.gap_c, 100 * s.gap_u);
+  }
+  std::printf(
+      "%zu sequences: step index right on %.2f%% of %d frames on the flight, count exact %d, phantom %d, "
+      "last step missed %d, gap max %.1f cm corrected / %.1f cm odometry only, riser err fused %.2f / single "
+      "%.2f cm, tread err fused %.2f / single %.2f cm\n",
+      all.size(), 100 * acc, tot.frames_on_stairs, exact, tot.phantom, missed, 100 * tot.gap_c,
+      100 * tot.gap_u, 100 * tot.fr / nf, 100 * tot.sr / nf, 100 * tot.ft / nf, 100 * tot.st / nf);
+  return 0;
+}
+
+}  // namespace
+
+SG_COMMAND("replay", "replay INPUT --out DIR [--frames N] [--drift SCALE_PERCENT,YAW_DEG_PER_S]",
+           "odometry, perception, stairs and traversal in order; frames.jsonl, trajectory.txt, traversal.png",
+           replay);
+SG_COMMAND("eval-traversal", "eval-traversal DIR... [--json]",
+           "scores replay folders: step index, count, phantom and last steps, drift gap, fused vs "
+           "single-frame model",
+           eval_traversal);
+
+}  // namespace stairguide::cli
