@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -178,4 +179,42 @@ TEST(E2eFeedback, MissingSoundDeviceAndGpioChipDaemonGoesOn) {
   EXPECT_NE(out.find("GPIO chip 'gpiochip_sg_absent' line 17: cannot open the chip"), std::string::npos)
       << out;
   EXPECT_NE(out.find("summary frames=10"), std::string::npos) << out;
+}
+
+// The climb as the wearer lives it, through the whole daemon with the traversal tracker: told of
+// the stairs ahead, then the first step, one cue per step after it (a tick, the count at its
+// interval, or "last step" for the one before the last), and the end of the stairs; heard in that
+// order.
+TEST(E2eFeedback, ClimbIsToldStepByStep) {
+  const Result r = run_daemon("e2e_climb8", "synth:climb_8_steps", "--realtime");
+  ASSERT_EQ(r.code, 0) << r.log;
+  std::vector<std::string> told;  // the frames' cue tokens, each '+'-joined list split
+  for (const auto& c : r.cues) {
+    std::istringstream is(c);
+    std::string t;
+    while (std::getline(is, t, '+'))
+      if (stair_token(t)) told.push_back(t.substr(0, t.find(':')));
+  }
+  std::printf("climb_8_steps: told %s\n", ::testing::PrintToString(told).c_str());
+  ASSERT_FALSE(told.empty());
+  EXPECT_EQ(told.front(), "stairs_ahead_up") << ::testing::PrintToString(told);
+  auto at = [&](const std::string& t) { return std::find(told.begin(), told.end(), t) - told.begin(); };
+  const auto first = at("first_step"), last = at("last_step"), end = at("end_of_stairs");
+  ASSERT_LT(first, static_cast<long>(told.size()));
+  ASSERT_LT(last, static_cast<long>(told.size()));
+  ASSERT_LT(end, static_cast<long>(told.size()));
+  EXPECT_LT(first, last);
+  EXPECT_LT(last, end);
+  int per_step = 0;
+  for (const auto& t : told) per_step += t == "first_step" || t == "tick" || t == "count" || t == "last_step";
+  EXPECT_EQ(per_step, 8) << "one cue per step of the 8: " << ::testing::PrintToString(told);
+  EXPECT_EQ(std::count(told.begin(), told.end(), "last_step"), 1);
+  EXPECT_EQ(std::count(told.begin(), told.end(), "end_of_stairs"), 1);
+  EXPECT_EQ(std::count(told.begin(), told.end(), "stairs_ahead_down"), 0);
+  const auto names = sgtest::names_of(sgtest::heard(r.audio, kStairClips));
+  std::printf("climb_8_steps: heard %s\n", ::testing::PrintToString(names).c_str());
+  std::vector<std::string> order;  // the spoken milestones, in the order heard
+  for (const auto& n : names)
+    if (n == "stairs_up" || n == "first_step" || n == "last_step" || n == "end_of_stairs") order.push_back(n);
+  EXPECT_EQ(order, (std::vector<std::string>{"stairs_up", "first_step", "last_step", "end_of_stairs"}));
 }

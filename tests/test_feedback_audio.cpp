@@ -2,6 +2,7 @@
 // through ALSA_CONFIG_PATH) writes exactly the samples the sink plays; the cues are found in
 // them, in order, by correlation with the WAVs.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -16,7 +17,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "feedback_audio_files";
+// One folder per process: ctest runs each test case in a process of its own, two at once, and a
+// case that rewrote the shared asound.conf took away the PCM another had just added.
+const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / ("feedback_audio_files." + std::to_string(getpid()));
+// Kept for a look when a case failed, removed otherwise.
+struct RemoveFilesWhenPassed : ::testing::Environment {
+  void TearDown() override {
+    std::error_code ec;
+    if (!::testing::UnitTest::GetInstance()->Failed()) fs::remove_all(kDir, ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kRemoveFiles =
+    ::testing::AddGlobalTestEnvironment(new RemoveFilesWhenPassed);
 
 /// ALSA reads its configuration once per process (and again when the file changes): one file
 /// with every PCM the tests use, set before the first ALSA call.
