@@ -3,6 +3,10 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+namespace YAML {
+class Node;
+}
+
 namespace stairguide {
 
 std::string trim(const std::string& s);
@@ -16,5 +20,8 @@ std::string describe_mat_type(const cv::Mat& m);
 cv::Mat depth_to_u16(const cv::Mat& depth_m, double scale);
 /// Lower-case file extension with the dot (".oni"), "" when none.
 std::string lower_extension(const std::string& path);
+/// A labels.yaml (per-frame or whole-folder) read strictly (strict_yaml.hpp: one document, no key
+/// twice, bounded size and nodes); throws SourceError naming the file.
+YAML::Node load_labels_file(const std::string& path);
 
 }  // namespace stairguide

@@ -9,8 +9,8 @@
 #include <set>
 #include <string>
 
+#include "capture_util.hpp"
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/config/strict_yaml.hpp"
 
 namespace stairguide {
 namespace {
@@ -80,17 +80,8 @@ class FolderReader {
 }  // namespace
 
 bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw SourceError(path + ": missing or not a regular file");
-  YAML::Node root;
-  try {
-    // The same strict reading and bounds as the per-frame labels (labels_yaml.cpp): one document,
-    // no key twice, no aliases, bounded size. A folder label is a few dozen nodes.
-    root = load_strict_yaml(read_small_file(path, 64u << 20, "labels.yaml"), path, YamlLimits{2000000, 8});
-  } catch (const InputFileError& e) {
-    throw SourceError(e.what());
-  }
+  // The same strict reading and bounds as the per-frame labels: one document, no key twice.
+  const YAML::Node root = load_labels_file(path);
   if (!root || !root.IsMap() || !root["folder"]) return false;  // a per-frame file, or not ours
   FolderReader top(root, path, "labels");
   const std::string format = top.scalar<std::string>("format");

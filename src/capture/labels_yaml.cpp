@@ -186,18 +186,21 @@ std::string labels_to_yaml(const std::vector<FrameTruth>& frames) {
   return o.str();
 }
 
-std::vector<FrameTruth> read_labels_yaml(const std::string& path) {
+YAML::Node load_labels_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw SourceError(path + ": missing or not a regular file");
-  YAML::Node root;
   try {
     // A labelled frame is about 1.2 kB and 130 nodes: these bounds are some 15000 frames with a
     // staircase each, and keep yaml-cpp's tree (a few hundred bytes a node) under a gigabyte.
-    root = load_strict_yaml(read_small_file(path, 64u << 20, "labels.yaml"), path, YamlLimits{2000000, 8});
+    return load_strict_yaml(read_small_file(path, 64u << 20, "labels.yaml"), path, YamlLimits{2000000, 8});
   } catch (const InputFileError& e) {
     throw SourceError(e.what());
   }
+}
+
+std::vector<FrameTruth> read_labels_yaml(const std::string& path) {
+  const YAML::Node root = load_labels_file(path);
   if (!root || root.IsNull()) throw SourceError(path + ": empty file");
   MapReader top(root, path, "labels");
   const std::string format = top.scalar<std::string>("format");
