@@ -111,6 +111,9 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
     floor.point_count += static_cast<int>(pool_[static_cast<std::size_t>(slot)].sample.size()) *
                          pool_[static_cast<std::size_t>(slot)].stride;
   }
+  // Read now: sweep() grows hyp.levels, and `floor` (a reference into it) dangles after a
+  // reallocation (ThreadSanitizer saw the read of freed memory below, in a walk's frame).
+  const bool floor_seen = !floor.regions.empty();
 
   // Candidates on this side of the floor, sorted by distance to it (Algorithm 1: sortByHeight).
   order_.clear();
@@ -148,7 +151,7 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
       assigned_ = saved_assigned_;
     }
   }
-  if (direction < 0 && floor_tracked_ && !floor.regions.empty()) {
+  if (direction < 0 && floor_tracked_ && floor_seen) {
     if (hyp.step_levels() == 0) {
       build_hidden(hyp);
     } else if (hyp.step_levels() == 1) {
@@ -167,7 +170,7 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
       }
     }
   }
-  if (hyp.step_levels() == 0 && direction > 0 && !floor.regions.empty()) build_stack(hyp);
+  if (hyp.step_levels() == 0 && direction > 0 && floor_seen) build_stack(hyp);
 
   hyp.rejected = 0;
   for (char a : assigned_)
@@ -179,8 +182,8 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
 }
 
 void StairDetection::sweep(StairHypothesis& hyp) {
-  const LevelSeed& floor = hyp.levels[0];
-  const bool floor_visible = !floor.regions.empty();
+  // hyp.levels grows below: the floor is read through the vector each time, never a held reference.
+  const bool floor_visible = !hyp.levels[0].regions.empty();
   const float hmin = cls_.step_height_min - cfg_.height_tolerance;
   const float hmax = cls_.step_height_max + cfg_.height_tolerance;
   // The first level may be a curb lower than H_min; modelling decides whether a low level is one.
@@ -198,7 +201,7 @@ void StairDetection::sweep(StairHypothesis& hyp) {
       const int n_levels = hyp.step_levels();
       if (n_levels == 0) {
         if (s < first_min || s > hmax) continue;
-        if (floor_visible && !connected(c, floor)) continue;
+        if (floor_visible && !connected(c, hyp.levels[0])) continue;
         LevelSeed& l = hyp.levels.emplace_back();
         l.index = 1;
         l.height = c.height;
