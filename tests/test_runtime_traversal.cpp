@@ -21,7 +21,9 @@ struct Figures {
   bool last_announced = false, arrived = false;
 };
 
-Figures run(const std::string& walk, std::uint32_t seed) {
+// `reload_every` > 0: the config is reloaded into both stages every that many frames, as a SIGHUP
+// does in the daemon.
+Figures run(const std::string& walk, std::uint32_t seed, long reload_every = 0) {
   synth::SynthOptions opt;
   opt.fps = 15.0;
   const long frames = synth::find_preset_info(walk)->default_frames / 2;
@@ -48,6 +50,10 @@ Figures run(const std::string& walk, std::uint32_t seed) {
     const StairTruth& st = truth.stairs.at(0);
     N = st.steps;
     tread = st.tread_m;
+    if (reload_every > 0 && seq > 0 && seq % static_cast<std::uint64_t>(reload_every) == 0) {
+      odometry.reconfigure(cfg);
+      perception.reconfigure(cfg);
+    }
     const OdometryOutput o = odometry.step(f);
     F.odometry_failures += !o.ok && o.status != "first frame";
     poses[seq] = o;
@@ -91,6 +97,20 @@ TEST(RuntimeTraversal, PerceptionStageCountsTheStepsWithOurOdometry) {
     EXPECT_TRUE(F.last_announced) << walk;
     EXPECT_TRUE(F.arrived) << walk;
   }
+}
+
+// A reload on the flight (SIGHUP, say for the verbosity) keeps the staircase and the count: it
+// restarted both from nothing, with the user on a step (measured before the fix: 0 of the 8 steps
+// counted, 0% of the frames right, with a reload every 4 s).
+TEST(RuntimeTraversal, AReloadOnTheFlightKeepsTheCount) {
+  const Figures F = run("climb_8_steps", 20261204u, 60);
+  ASSERT_GT(F.on_stairs, 50);
+  // Measured: 94.3% (100% without reloads). Perception's own memory (the floor, the Manhattan
+  // frame) still starts afresh at a reload, and the frames just after it correct the staircase
+  // less well; the count stays exact.
+  EXPECT_GE(F.right, 0.90 * F.on_stairs);
+  EXPECT_EQ(F.phantom, 0);
+  EXPECT_TRUE(F.last_announced);
 }
 
 // Without the odometry (no lookup), the tracker still runs (the camera taken as still between the

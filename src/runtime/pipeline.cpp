@@ -212,8 +212,15 @@ void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, 
 }
 
 void PerceptionStage::reconfigure(const PipelineConfig& config) {
-  // The stages take their config at construction; tracking restarts with the new values.
+  // The stages take their config at construction; tracking restarts with the new values. Not the
+  // traversal: a reload on the stairs (a SIGHUP for the verbosity) would have started the count
+  // again from nothing under the user's feet. The odometry keeps its world over a reload, so the
+  // staircase held in it stays where it is.
+  TraversalTracker traversal = std::move(impl_->traversal);
   impl_ = std::make_unique<Impl>(config);
+  impl_->traversal = std::move(traversal);
+  impl_->traversal.reconfigure(config.traversal);
+  if (!config.traversal.enabled) impl_->traversal.reset();
 }
 bool PerceptionStage::available() const { return true; }
 std::string PerceptionStage::describe() const {

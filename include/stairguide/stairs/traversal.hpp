@@ -48,6 +48,9 @@ class TraversalTracker {
 
   /// Forgets the staircase (and the memory): searching from nothing.
   void reset();
+  /// New values from a reloaded config, from the next frame on; the staircase held, the count and
+  /// the memory are kept (a reload on the flight must not lose the user's step).
+  void reconfigure(const TraversalConfig& config) { cfg_ = config; }
   const TraversalResult& result() const { return out_; }
   /// The staircase held (tracked or remembered).
   bool holding() const { return model_.valid; }
