@@ -84,8 +84,9 @@ void ascending_static(Rng& rng, const SynthOptions& o, PresetBuild& b, int min_s
   b.view = random_view(rng, o);
 }
 
-void descending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  StairParams p = random_stair(rng, StairKind::kDescending);
+// A descending flight ahead in a room of walls down to its foot (descending_static and the
+// world's descending flight: they differ in how the flight's dimensions are drawn).
+void descending_in_room(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p) {
   float d = 0.f;
   p.T_world_stair = stair_ahead(rng, 0.f, 0.f, &d);
   p.side_walls = rng.chance(0.7f);
@@ -95,6 +96,10 @@ void descending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + static_cast<float>(p.steps) * p.tread_m + 5.f, 4.f),
                  -total - 0.2f, 2.7f + total + 0.2f, wall_material(rng));
   b.view = random_view(rng, o);
+}
+
+void descending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  descending_in_room(rng, o, b, random_stair(rng, StairKind::kDescending));
 }
 
 void open_risers_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
@@ -528,16 +533,7 @@ void world_ascending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
 }
 
 void world_descending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  StairParams p = world_stair(rng, StairKind::kDescending);
-  float d = 0.f;
-  p.T_world_stair = stair_ahead(rng, 0.f, 0.f, &d);
-  p.side_walls = rng.chance(0.7f);
-  p.handrails = !p.side_walls || rng.chance(0.3f);
-  const float total = static_cast<float>(p.steps) * p.riser_m;
-  add_staircase(b.scene, p, rng);
-  add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + static_cast<float>(p.steps) * p.tread_m + 5.f, 4.f),
-                 -total - 0.2f, 2.7f + total + 0.2f, wall_material(rng));
-  b.view = random_view(rng, o);
+  descending_in_room(rng, o, b, world_stair(rng, StairKind::kDescending));
 }
 
 // ---- traversal walks (issue 32): climbs and descents of 3, 8 and 14 steps onto a landing ----
