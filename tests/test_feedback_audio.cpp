@@ -228,7 +228,10 @@ TEST(FeedbackAlsa, DeviceThatAppearsLaterIsOpenedAtTheNextRetry) {
     sink.play(utt(1, 4, {"camera_back"}));
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
     EXPECT_GE(sink.counters().open_failures, 1u);
-    // The device comes (ALSA reads its configuration again when the file changes).
+    // The device comes (ALSA reads its configuration again when the file changes). ALSA tells a
+    // changed file by its modification time in whole seconds: a rewrite within the same second
+    // as the first write went unseen (the case failed on half its runs), so wait for the next.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
     sgtest::write_alsa_config(kDir / "asound.conf", kDir, {"sg_order", "sg_cut", "sg_latency", "sg_late"});
     ASSERT_TRUE(sink.drain(std::chrono::seconds(5)));
     EXPECT_TRUE(sink.counters().device_open);
