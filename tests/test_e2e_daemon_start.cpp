@@ -166,6 +166,10 @@ TEST(DaemonStart, UnitTimesOutAStuckStartAndDoesNotRestartOnABadConfig) {
   EXPECT_NE(unit.find("\nRestart=on-failure\n"), std::string::npos);
   // 3 is what stairguided exits with on a config error, 2 on bad arguments (its usage text).
   EXPECT_NE(unit.find("\nRestartPreventExitStatus=2 3\n"), std::string::npos);
+  // The buzzer's timing thread may have SCHED_FIFO 10 as the unprivileged user, and no more.
+  EXPECT_EQ(unit.find("RestrictRealtime=yes"), std::string::npos);
+  EXPECT_NE(unit.find("\nLimitRTPRIO=10\n"), std::string::npos);
+  EXPECT_NE(unit.find("\nSystemCallFilter=sched_setscheduler"), std::string::npos);
   Child d({"--config", "/nonexistent/stairguide.yaml"});
   EXPECT_EQ(d.wait_exit(20), 3);
   Child e({"--frobnicate"});

@@ -1,5 +1,8 @@
 #include "stairguide/feedback/haptic.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <gpiod.hpp>
 #include <stdexcept>
 #include <system_error>
@@ -122,6 +125,12 @@ void HapticPlayer::play(const HapticPattern& p, int priority) {
   cv_.notify_all();
 }
 
+bool HapticPlayer::realtime() {
+  std::unique_lock<std::mutex> lk(m_);
+  cv_.wait(lk, [&] { return realtime_ >= 0; });
+  return realtime_ == 1;
+}
+
 bool HapticPlayer::drain(std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lk(m_);
   return cv_.wait_for(lk, timeout, [&] { return pending_priority_ < 0 && playing_priority_ < 0; });
@@ -129,6 +138,14 @@ bool HapticPlayer::drain(std::chrono::milliseconds timeout) {
 
 void HapticPlayer::run() {
   using Clock = std::chrono::steady_clock;
+  {
+    sched_param sp{};
+    sp.sched_priority = kRealtimePriority;
+    const bool rt = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+    std::lock_guard<std::mutex> lk(m_);
+    realtime_ = rt ? 1 : 0;
+  }
+  cv_.notify_all();
   for (;;) {
     HapticPattern p;
     std::uint64_t gen = 0;

@@ -74,8 +74,15 @@ struct FeedbackStage::Impl {
     haptic = std::make_unique<fb::NullHaptic>();
     if (f.haptic_enabled) {
       try {
-        haptic = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
-        spdlog::info("haptic: buzzer on {}", haptic->describe());
+        auto player = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
+        if (player->realtime()) {
+          spdlog::info("haptic: buzzer on {}, timed at real-time priority", player->describe());
+        } else {
+          spdlog::warn("haptic: buzzer on {}, but its timing thread was refused real-time priority "
+                       "(needs root or LimitRTPRIO>={}); pulses may come a few ms late on a busy machine",
+                       player->describe(), fb::HapticPlayer::kRealtimePriority);
+        }
+        haptic = std::move(player);
       } catch (const std::exception& e) {
         spdlog::error("{}; going on with audio only (feedback.haptic_enabled: false silences this)",
                       e.what());
