@@ -1,10 +1,14 @@
 // Config loader: the shipped file, and each kind of invalid input with file, line and key.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <string>
 
 #include "stairguide/config/config_loader.hpp"
@@ -265,6 +269,31 @@ TEST(Config, HugeOrSpecialFilesAreRefusedWithoutReadingThem) {
   } catch (const ConfigError& x) {
     EXPECT_NE(std::string(x.what()).find(fifo + ": config file is a FIFO"), std::string::npos) << x.what();
   }
+  std::remove(fifo.c_str());
+}
+
+TEST(Config, TheDefaultPathIsProbedWithoutOpeningAFifoThere) {
+  // A FIFO at /etc/stairguide/stairguide.yaml blocked the daemon before it logged a line: the
+  // probe opened it to see whether it was readable. It is chosen by stat alone, then refused.
+  const std::string fifo = std::string(STAIRGUIDE_BINARY_DIR) + "/test_config_probe_fifo.yaml";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  auto probe = std::async(std::launch::async, [&] {
+    return first_config_path({"", std::string(STAIRGUIDE_BINARY_DIR) + "/absent.yaml", fifo,
+                              std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml"});
+  });
+  if (probe.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+    const int fd = ::open(fifo.c_str(), O_RDWR);  // a writer releases the blocked open
+    probe.wait();
+    if (fd >= 0) ::close(fd);
+    FAIL() << "probing the config path blocked on a FIFO";
+  }
+  EXPECT_EQ(probe.get(), fifo);
+  EXPECT_THROW(load_config(fifo), ConfigError);
+  // A directory is skipped; an absent path is skipped; nothing there gives "" (built-in defaults).
+  EXPECT_EQ(first_config_path({STAIRGUIDE_BINARY_DIR, std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml"}),
+            std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml");
+  EXPECT_EQ(first_config_path({std::string(STAIRGUIDE_BINARY_DIR) + "/absent.yaml"}), "");
   std::remove(fifo.c_str());
 }
 

@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <initializer_list>
 #include <map>
 #include <set>
@@ -234,14 +233,12 @@ class Writer {
   }
 };
 
-bool is_directory(const std::string& p) {
+// Whether a config candidate is there, by stat alone: opening it to see would block for ever on a
+// FIFO with no writer. Anything there but a directory is chosen; load_config then reads a regular
+// file or names what else it is (a FIFO, a device) and refuses it.
+bool config_candidate_exists(const std::string& p) {
   struct stat st {};
-  return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-bool is_readable_file(const std::string& p) {
-  std::ifstream f(p);
-  return f.good() && !is_directory(p);
+  return ::stat(p.c_str(), &st) == 0 && !S_ISDIR(st.st_mode);
 }
 
 }  // namespace
@@ -302,12 +299,19 @@ std::string dump_config_yaml(const PipelineConfig& config) {
   return w.os.str();
 }
 
+std::string first_config_path(const std::vector<std::string>& candidates) {
+  for (const auto& c : candidates) {
+    if (!c.empty() && config_candidate_exists(c)) return c;
+  }
+  return "";
+}
+
 std::string default_config_path() {
   if (const char* env = std::getenv("STAIRGUIDE_CONFIG"); env && *env) return env;
-  if (is_readable_file("/etc/stairguide/stairguide.yaml")) return "/etc/stairguide/stairguide.yaml";
-  const std::string src = std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml";
-  if (std::string(STAIRGUIDE_SOURCE_DIR).size() && is_readable_file(src)) return src;
-  return "";
+  std::vector<std::string> candidates{"/etc/stairguide/stairguide.yaml"};
+  if (std::string(STAIRGUIDE_SOURCE_DIR).size())
+    candidates.push_back(std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml");
+  return first_config_path(candidates);
 }
 
 }  // namespace stairguide

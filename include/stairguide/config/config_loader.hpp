@@ -35,6 +35,11 @@ std::string dump_config_yaml(const PipelineConfig& config);
 
 /// Default config path: $STAIRGUIDE_CONFIG, else /etc/stairguide/stairguide.yaml when it exists,
 /// else the source tree's config/stairguide.yaml when it exists, else empty (built-in defaults).
+/// Existence is checked with stat alone (never by opening: a FIFO there would block); a FIFO or
+/// device there is chosen, and load_config refuses it by name.
 std::string default_config_path();
+
+/// The first of `candidates` that exists and is not a directory (stat only), else "".
+std::string first_config_path(const std::vector<std::string>& candidates);
 
 }  // namespace stairguide
