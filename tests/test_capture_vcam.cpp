@@ -119,9 +119,12 @@ TEST_F(VirtualCamera, DeviceSourceReadsTheDatasetsFramesExactlyAt30Hz) {
   const double wall = since(t0), sensor = f.timestamp - ts0;
   EXPECT_EQ(seen.size(), static_cast<std::size_t>(kFrames)) << "the loop goes through every frame";
   EXPECT_GT(valid_pixels, 45L * 640 * 480 / 2) << "real depth images, mostly valid";
-  // 30 Hz on the wall clock: 45 frames in 1.5 s, the sensor clock in step with it.
-  EXPECT_NEAR(sensor, 45.0 / 30.0, 0.2) << "frames were dropped or doubled";
+  // 30 Hz on the wall clock: the sensor clock keeps step with it, no frame comes twice or early
+  // (45 reads span at least 45 ticks), and a reader that keeps up loses few (at most a fifth, for
+  // a loaded machine; none on a quiet one).
   EXPECT_NEAR(wall, sensor, 0.25);
+  EXPECT_GE(sensor, 45.0 / 30.0 - 1e-3) << "a frame came twice or faster than 30 Hz";
+  EXPECT_LE(sensor, 45.0 / 30.0 / 0.8) << "more than a fifth of the frames were lost";
   EXPECT_EQ(src.frames_without_color(), 0);
 }
 
