@@ -67,6 +67,7 @@ class LiveDaemon {
     std::memcpy(addr.sun_path + 1, name_.data(), name_.size());
     const auto len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + name_.size());
     if (bind(fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) ADD_FAILURE() << "bind";
+    fs::remove(log);  // an old log must not answer for this run before the child truncates it
     pid_ = fork();
     if (pid_ == 0) {
       const int null = open("/dev/null", O_WRONLY);
@@ -259,4 +260,41 @@ TEST(LiveDaemonOnVirtualCamera, SeesStairsLosesTheCameraOnUnplugBacksOffAndComes
   fs::remove(control);
   fs::remove(config);
   if (!HasFailure()) fs::remove(log_path);  // kept for a look when the test failed
+}
+
+// A dataset the driver cannot serve is named on stderr (so in the daemon's log), and the daemon
+// waits for a camera as it does with none plugged in.
+TEST(LiveDaemonOnVirtualCamera, ADatasetItCannotServeIsNamedAndTheDaemonWaitsForACamera) {
+  fs::create_directories(kDir);
+  PipelineConfig c;
+  c.capture.device_uri = "sgvcam://0";
+  c.capture.retry_min = 0.2f;
+  c.feedback.audio_enabled = false;
+  c.feedback.haptic_enabled = false;
+  const fs::path config = kDir / ("bad-dataset." + std::to_string(getpid()) + ".yaml");
+  {
+    std::ofstream f(config);
+    f << dump_config_yaml(c);
+  }
+  const fs::path control = kDir / ("bad-dataset-control." + std::to_string(getpid()));
+  const fs::path log_path = kDir / ("bad-dataset." + std::to_string(getpid()) + ".log");
+  const fs::path missing = kDir / "no-such-dataset";
+  struct Case {
+    fs::path dataset;
+    std::string says;
+  };
+  for (const Case& k :
+       {Case{missing, "sgvcam: SGVCAM_DATASET=" + missing.string() + ": " + missing.string() +
+                          "/camera.yaml: missing; the virtual camera is not there"},
+        Case{"vcam_test_files/ascending_640",
+             "sgvcam: SGVCAM_DATASET=vcam_test_files/ascending_640: must be an absolute path"}}) {
+    LiveDaemon d(config, k.dataset, control, log_path);
+    SCOPED_TRACE(k.dataset.string());
+    EXPECT_TRUE(d.wait_log("camera not available", 20)) << d.log();
+    EXPECT_NE(d.log().find(k.says), std::string::npos) << d.log();
+    EXPECT_EQ(d.count_log("camera open"), 0) << d.log();
+    EXPECT_EQ(d.stop(5.0), 0) << d.log();
+  }
+  fs::remove(config);
+  if (!HasFailure()) fs::remove(log_path);
 }

@@ -8,6 +8,7 @@
 // folder's image size, with the fields of view of its camera.yaml. The device's URI is
 // "sgvcam://0". Without $SGVCAM_DATASET the driver has no device at all.
 //
+// Both paths must be absolute (OpenNI2 initializes its drivers from inside their folder).
 // Unplug and replug: $SGVCAM_CONTROL names a file polled every frame period. "unplugged" (on its
 // own, surrounding white space ignored) unplugs the camera as a USB unplug does: its streams stop
 // delivering, OpenNI2's device-disconnected event fires and the device leaves the enumeration;
@@ -327,13 +328,19 @@ class VcamDriver : public oni::driver::DriverBase {
     DriverBase::initialize(connected, disconnected, state, cookie);
     const char* dir = std::getenv("SGVCAM_DATASET");
     if (!dir || !*dir) return ONI_STATUS_OK;  // no clip, no camera
+    const char* control = std::getenv("SGVCAM_CONTROL");
     try {
+      // OpenNI2 initializes its drivers with the current directory changed to theirs: a relative
+      // path would name a file in there.
+      if (dir[0] != '/') throw std::runtime_error("must be an absolute path");
+      if (control && *control && control[0] != '/')
+        throw std::runtime_error(std::string("SGVCAM_CONTROL=") + control + " must be an absolute path");
       clip_ = load_clip(dir);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "sgvcam: SGVCAM_DATASET=%s: %s; the virtual camera is not there\n", dir, e.what());
       return ONI_STATUS_OK;
     }
-    if (const char* c = std::getenv("SGVCAM_CONTROL")) control_ = c;
+    if (control) control_ = control;
     have_clip_ = true;
     plugged_ = read_control(true);
     if (plugged_) deviceConnected(&info_);
