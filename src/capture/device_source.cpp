@@ -40,8 +40,6 @@ std::string list_modes(const openni::SensorInfo* info) {
   return s.empty() ? "none" : s;
 }
 
-}  // namespace
-
 // OpenNI2's device-disconnected event (a USB unplug) for one URI: read() reports the camera gone
 // at once instead of after read_timeout without frames. Raised on the driver's thread.
 struct UnplugListener : openni::OpenNI::DeviceDisconnectedListener {
@@ -51,6 +49,8 @@ struct UnplugListener : openni::OpenNI::DeviceDisconnectedListener {
     if (info && uri == info->getUri()) gone = true;
   }
 };
+
+}  // namespace
 
 struct DeviceSource::Impl {
   CaptureConfig config;
