@@ -1,4 +1,6 @@
 // Live OpenNI2 camera.
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgproc.hpp>
@@ -38,6 +40,16 @@ std::string list_modes(const openni::SensorInfo* info) {
   return s.empty() ? "none" : s;
 }
 
+// OpenNI2's device-disconnected event (a USB unplug) for one URI: read() reports the camera gone
+// at once instead of after read_timeout without frames. Raised on the driver's thread.
+struct UnplugListener : openni::OpenNI::DeviceDisconnectedListener {
+  std::string uri;
+  std::atomic<bool> gone{false};
+  void onDeviceDisconnected(const openni::DeviceInfo* info) override {
+    if (info && uri == info->getUri()) gone = true;
+  }
+};
+
 }  // namespace
 
 struct DeviceSource::Impl {
@@ -52,8 +64,11 @@ struct DeviceSource::Impl {
   long without_color = 0;
   std::uint64_t next = 0;
   CameraIntrinsics k;
+  UnplugListener unplug;
+  bool listening = false;
 
   ~Impl() {
+    if (listening) openni::OpenNI::removeDeviceDisconnectedListener(&unplug);
     if (color.isValid()) {
       color.stop();
       color.destroy();
@@ -92,6 +107,8 @@ DeviceSource::DeviceSource(const CaptureConfig& config, const std::string& uri)
     throw SourceError(m.name + ": cannot open: " + openni_error("open failed") +
                       (cameras ? " (cameras found: " + uris + ")" : " (no camera found)"));
   const openni::DeviceInfo& info = m.device.getDeviceInfo();
+  m.unplug.uri = info.getUri();
+  m.listening = openni::OpenNI::addDeviceDisconnectedListener(&m.unplug) == openni::STATUS_OK;
   m.name =
       std::string("OpenNI2 device ") + info.getVendor() + " " + info.getName() + " (" + info.getUri() + ")";
 
@@ -138,7 +155,19 @@ ReadResult DeviceSource::read(RgbdFrame& out) {
   const int timeout_ms = std::max(1, static_cast<int>(std::lround(m.config.read_timeout * 1000.0)));
   openni::VideoStream* ds[] = {&m.depth};
   int ready = -1;
-  const openni::Status st = openni::OpenNI::waitForAnyStream(ds, 1, &ready, timeout_ms);
+  // Waits in slices so that an unplug, which stops the frames, is reported when it happens.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  openni::Status st = openni::STATUS_TIME_OUT;
+  for (;;) {
+    if (m.unplug.gone)
+      return {ReadStatus::kError, m.name + ": unplugged (OpenNI2 reported the device disconnected)"};
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now())
+            .count();
+    if (left <= 0) break;
+    st = openni::OpenNI::waitForAnyStream(ds, 1, &ready, static_cast<int>(std::min<long long>(left, 100)));
+    if (st != openni::STATUS_TIME_OUT) break;
+  }
   if (st == openni::STATUS_TIME_OUT)
     return {ReadStatus::kTimeout,
             m.name + ": no depth frame within " + fmt_num(m.config.read_timeout) + " s"};

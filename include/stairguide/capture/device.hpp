@@ -13,7 +13,9 @@ namespace stairguide {
 /// depth registered to colour when the device allows it and the config asks for it, mirroring as
 /// configured (off for a body camera), depth/colour frame sync on. read() waits up to
 /// `read_timeout` for a depth frame and reports kTimeout when none came (the caller decides when
-/// the camera counts as lost and reopens it); kError when the device is gone.
+/// the camera counts as lost and reopens it); kError when the device is gone, at once when OpenNI2
+/// reports it disconnected (a USB unplug fires its device-disconnected event), without waiting
+/// out `read_timeout`. A source whose device was unplugged stays dead: open a new one.
 class DeviceSource : public FrameSource {
  public:
   /// Opens `uri` (empty: config.device_uri, and when that is empty too the first camera found).
