@@ -55,10 +55,13 @@ TEST(Config, PaperValuesAreTheDefaults) {
   EXPECT_FLOAT_EQ(c.segmentation.region_curvature, 0.5f);
   EXPECT_EQ(c.segmentation.region_min_points, 50);
   EXPECT_FLOAT_EQ(c.segmentation.planarity_min_inliers, 0.8f);
-  EXPECT_NEAR(c.floor.tilt_min, 20.0 * M_PI / 180.0, 1e-6);
-  EXPECT_NEAR(c.floor.tilt_max, 70.0 * M_PI / 180.0, 1e-6);
-  EXPECT_FLOAT_EQ(c.floor.height_min, 1.0f);
-  EXPECT_FLOAT_EQ(c.floor.height_max, 1.6f);
+  // The floor gate is any chest or waist rig's (issue 34: 0.5-1.8 m, 15-80 deg, with a margin for
+  // a walk's wobble), not the paper's 20-70 deg and 1-1.6 m (config/profiles/paper.yaml;
+  // Config.PaperProfileIsTheSpanishCode).
+  EXPECT_NEAR(c.floor.tilt_min, 10.0 * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(c.floor.tilt_max, 85.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(c.floor.height_min, 0.4f);
+  EXPECT_FLOAT_EQ(c.floor.height_max, 1.9f);
   EXPECT_NEAR(c.classification.parallel_threshold, 10.0 * M_PI / 180.0, 1e-6);
   // The building code is the world's, not the paper's Spanish one (config/profiles/paper.yaml
   // holds that; Config.PaperProfileIsTheSpanishCode).
@@ -98,11 +101,20 @@ TEST(Config, PaperProfileIsTheSpanishCode) {
   EXPECT_FLOAT_EQ(p.stair_modelling.blondel_min, 0.54f);
   EXPECT_FLOAT_EQ(p.stair_modelling.blondel_max, 0.70f);
   EXPECT_FLOAT_EQ(p.stair_modelling.width_min, 0.60f);
-  // Nothing else moves: put the eight keys back and the profile is the defaults.
+  // ... and the paper's chest-camera floor gate (3.2.1).
+  EXPECT_NEAR(p.floor.tilt_min, 20.0 * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(p.floor.tilt_max, 70.0 * M_PI / 180.0, 1e-6);
+  EXPECT_FLOAT_EQ(p.floor.height_min, 1.0f);
+  EXPECT_FLOAT_EQ(p.floor.height_max, 1.6f);
+  // Nothing else moves: put the twelve keys back and the profile is the defaults.
   PipelineConfig back = p;
   back.classification.step_height_min = d.classification.step_height_min;
   back.classification.step_height_max = d.classification.step_height_max;
   back.stair_modelling = d.stair_modelling;
+  back.floor.tilt_min = d.floor.tilt_min;
+  back.floor.tilt_max = d.floor.tilt_max;
+  back.floor.height_min = d.floor.height_min;
+  back.floor.height_max = d.floor.height_max;
   std::string diff;
   EXPECT_TRUE(config_equal(back, d, &diff)) << "the profile also changes " << diff;
 }

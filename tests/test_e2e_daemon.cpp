@@ -322,6 +322,12 @@ TEST_F(DaemonE2E, ReplayThatEndsExitsZeroWithEveryFrameThroughOdometry) {
   EXPECT_EQ(perceived, std::stol(summary.at("perception_frames")));
   EXPECT_GT(stairs, 0) << "the climb's staircase is seen at least once";
   EXPECT_TRUE(d.wait_notify("READY=1", 1));
+  // The wearer's rig, learned from the first clear views of the floor (a chest camera 1.2-1.45 m
+  // up in this walk), is logged once.
+  const std::string err = d.stderr_text();
+  const auto at = err.find("rig learned: the camera 1.");
+  EXPECT_NE(at, std::string::npos) << err;
+  EXPECT_EQ(err.find("rig learned", at + 1), std::string::npos) << err;
 }
 
 TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {

@@ -126,3 +126,37 @@ TEST(RuntimeTraversal, DisabledInTheConfigLeavesTheSeam) {
   EXPECT_FALSE(p.traversal.ran);
   EXPECT_NE(perception.describe().find("disabled"), std::string::npos);
 }
+
+// A reload keeps the wearer's rig too: a waist rig (0.7 m, outside the usual chest band) needs
+// rig_learn_frames clear views before its floor is believed; after a SIGHUP the floor is there on
+// the next frame, and the rig is not logged as learned anew.
+TEST(RuntimeTraversal, AReloadKeepsTheLearnedRig) {
+  PipelineConfig cfg;
+  PerceptionStage perception(cfg);
+  synth::SynthOptions o;
+  o.camera_height_m = 0.7f;
+  o.camera_tilt_deg = 45.f;
+  RgbdFrame f;
+  FrameTruth truth;
+  const long learn = cfg.floor.rig_learn_frames;
+  PerceptionOutput p;
+  long seq = 0;
+  for (; seq < learn; ++seq) {
+    synth::render_preset_frame("rig_floor_static", seq, 4106u, o, f, truth);
+    p = perception.step(f, static_cast<std::uint64_t>(seq), nullptr);
+    if (seq < learn - 1) {
+      EXPECT_FALSE(p.floor_found) << "view " << seq << " believed before the rig was learned";
+    }
+  }
+  ASSERT_TRUE(p.floor_found) << p.detail;
+  EXPECT_NEAR(p.rig_height_m, 0.7f, 0.03f);
+  EXPECT_NEAR(p.rig_tilt_rad * 57.29578f, 45.f, 3.f);
+  const int learned = p.rig_learned;
+  EXPECT_EQ(learned, 1);
+  perception.reconfigure(cfg);
+  synth::render_preset_frame("rig_floor_static", seq, 4106u, o, f, truth);
+  p = perception.step(f, static_cast<std::uint64_t>(seq), nullptr);
+  EXPECT_TRUE(p.floor_found) << "the rig forgotten at the reload: " << p.detail;
+  EXPECT_NEAR(p.rig_height_m, 0.7f, 0.03f);
+  EXPECT_EQ(p.rig_learned, learned);
+}

@@ -38,6 +38,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
     for (const auto& p : detail::preset_defs()) known += (known.empty() ? "" : ", ") + p.info.name;
     for (const auto& p : detail::world_preset_defs()) known += ", " + p.info.name;
     for (const auto& p : detail::walk_defs()) known += ", " + p.info.name;
+    for (const auto& p : detail::rig_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -144,8 +145,17 @@ const std::vector<PresetInfo>& walk_presets() {
   return list;
 }
 
+const std::vector<PresetInfo>& rig_presets() {
+  static const std::vector<PresetInfo> list = [] {
+    std::vector<PresetInfo> v;
+    for (const auto& d : detail::rig_defs()) v.push_back(d.info);
+    return v;
+  }();
+  return list;
+}
+
 const PresetInfo* find_preset_info(const std::string& name) {
-  for (const auto* l : {&presets(), &world_presets(), &walk_presets()})
+  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets()})
     for (const auto& p : *l)
       if (p.name == name) return &p;
   return nullptr;

@@ -101,6 +101,8 @@ std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c) {
   order(c.capture.retry_min, c.capture.retry_max, "capture.retry_min_s", "capture.retry_max_s");
   order(c.floor.tilt_min, c.floor.tilt_max, "floor.tilt_min_deg", "floor.tilt_max_deg");
   order(c.floor.height_min, c.floor.height_max, "floor.height_min_m", "floor.height_max_m");
+  order(c.floor.usual_tilt_min, c.floor.usual_tilt_max, "floor.usual_tilt_min_deg", "floor.usual_tilt_max_deg");
+  order(c.floor.usual_height_min, c.floor.usual_height_max, "floor.usual_height_min_m", "floor.usual_height_max_m");
   order(c.floor.search_start, c.floor.search_max, "floor.search_start_m", "floor.search_max_m");
   order(c.floor.ambiguous_rise_min, c.floor.ambiguous_rise_max, "floor.ambiguous_rise_min_cm",
         "floor.ambiguous_rise_max_cm");

@@ -139,6 +139,9 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   out.manhattan_found = m.scene.manhattan_found;
   out.manhattan_carried = m.scene.manhattan_carried;
   out.manhattan_yaw = m.scene.manhattan_yaw;
+  out.rig_height_m = m.perception.floor_detector().rig_height();
+  out.rig_tilt_rad = m.perception.floor_detector().rig_tilt();
+  out.rig_learned = m.perception.floor_detector().rig_learned();
   // The stair stage runs without a floor too: its floorless route (when configured) finds a stack
   // of treads by their own vertical, with the distance from the user's feet unknown.
   m.stairs.run(m.scene, &frame.intrinsics, m.stair);
@@ -217,8 +220,12 @@ void PerceptionStage::reconfigure(const PipelineConfig& config) {
   // again from nothing under the user's feet. The odometry keeps its world over a reload, so the
   // staircase held in it stays where it is.
   TraversalTracker traversal = std::move(impl_->traversal);
+  // Nor the wearer's rig: it is the same person with the same camera (a waist rig would have
+  // waited rig_learn_frames views for its floor again).
+  const FloorDetector::Rig rig = impl_->perception.floor_detector().rig();
   impl_ = std::make_unique<Impl>(config);
   impl_->traversal = std::move(traversal);
+  impl_->perception.restore_rig(rig);
   impl_->traversal.reconfigure(config.traversal);
   if (!config.traversal.enabled) impl_->traversal.reset();
 }

@@ -601,6 +601,8 @@ struct Runtime::Impl {
 
   // ================================ feedback / reporting ================================
 
+  int logged_rig = 0;  // PerceptionOutput::rig_learned last logged (feedback thread)
+
   std::uint64_t skipped_count() const { return perc_in.overwritten(); }
   std::uint64_t lost_count() const { return odo_in->dropped() + odo_lost_sync.load(); }
 
@@ -621,6 +623,13 @@ struct Runtime::Impl {
     }
     decisions.fetch_add(1);
     if (d.changed) spdlog::info("frame {}: state {} ({})", m.out.seq, d.state, m.out.detail);
+    if (m.out.rig_learned != logged_rig && m.out.rig_height_m > 0.f) {
+      // Learned from the first clear views, relearned when the wearer sits down or remounts the
+      // rig: where the floor is looked for from now on.
+      spdlog::info("frame {}: rig {}: the camera {:.2f} m above the floor, tilted {:.0f} deg down", m.out.seq,
+                   logged_rig > 0 ? "relearned" : "learned", m.out.rig_height_m, m.out.rig_tilt_rad * 57.29578f);
+      logged_rig = m.out.rig_learned;
+    }
     if (!d.cue.empty()) spdlog::info("frame {}: cue {}", m.out.seq, d.cue);
     perc_pending.push_back(std::move(m));
   }

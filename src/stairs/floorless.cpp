@@ -404,7 +404,7 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
       votes_down >= std::max(2, n - 3)) {
     const float cam_above = -nodes_[static_cast<std::size_t>(chain_.back())].height;
     const float tol = det_.same_level_tolerance;
-    if (cam_above >= floor_.height_min - tol && cam_above <= floor_.height_max + tol) {
+    if (cam_above >= floor_.usual_height_min - tol && cam_above <= floor_.usual_height_max + tol) {
       trace_.floor_beside = true;
       chain_.pop_back();
       trace_.level_heights.pop_back();
@@ -495,7 +495,7 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   // farther, is a step whatever its depth. A camera held level (a hand-held or tripod view) says
   // nothing of its height: there the rule does not apply.
   const float cam_above = -nodes_[static_cast<std::size_t>(chain_[0])].height;
-  const bool chest_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
+  const bool chest_view = trace_.tilt >= floor_.usual_tilt_min && trace_.tilt <= floor_.usual_tilt_max;
   // Every tread of a flight has the same depth (building codes allow about 1 cm between the
   // deepest and the shallowest), so a level seen deeper than the fitted tread plus the measuring
   // slack is no tread of this flight: it is the floor. From a chest camera the level cut by the
@@ -505,15 +505,15 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   const float floor_depth = chest_view && out.tread_m > 0.f ? out.tread_m + kFloorDepthSlack
                                                              : std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
   const bool deep = depth > floor_depth;
-  const bool floor_height = cam_above >= floor_.height_min - det_.same_level_tolerance &&
-                            cam_above <= floor_.height_max + det_.same_level_tolerance;
+  const bool floor_height = cam_above >= floor_.usual_height_min - det_.same_level_tolerance &&
+                            cam_above <= floor_.usual_height_max + det_.same_level_tolerance;
   if (chest_view && !floor_height) return;
   // The other way round: were the level a first tread, the user's floor would lie one riser
   // below it (ascending) or above it (descending); outside a chest camera's height range that
   // cannot be the user's floor, so the level is.
   const float tread_cam = cam_above + static_cast<float>(dir) * out.riser_m;
-  const bool tread_height = tread_cam >= floor_.height_min - det_.same_level_tolerance &&
-                            tread_cam <= floor_.height_max + det_.same_level_tolerance;
+  const bool tread_height = tread_cam >= floor_.usual_height_min - det_.same_level_tolerance &&
+                            tread_cam <= floor_.usual_height_max + det_.same_level_tolerance;
   if (!deep && (!chest_view || tread_height)) {
     out.detected = false;
     out.verdict = StairVerdict::kNoFirstStep;
@@ -564,7 +564,7 @@ float FloorlessStairs::seen_floor_height(int dir, float riser) const {
     if (std::find(chain_.begin(), chain_.end(), i) != chain_.end()) continue;
     const Node& f = nodes_[static_cast<std::size_t>(i)];
     const float cam_above = -f.height;
-    if (cam_above < floor_.height_min - tol || cam_above > floor_.height_max + tol) continue;
+    if (cam_above < floor_.usual_height_min - tol || cam_above > floor_.usual_height_max + tol) continue;
     // On the user's side of the flight: below its first level ascending, above it descending.
     const float a0 = static_cast<float>(dir) * (h0 - f.height);
     const int k = static_cast<int>(std::lround(a0 / riser));

@@ -40,6 +40,10 @@ const std::vector<PresetInfo>& world_presets();
 /// down "descen". Kept out of presets() so the suites that run every preset keep their figures;
 /// make_source() and build_preset_frame() know them.
 const std::vector<PresetInfo>& walk_presets();
+/// Views from any chest or waist rig (issue 34): the camera 0.5-1.8 m high, tilted 15-80 deg, in an
+/// empty room or before a table, bed, bench or raised landing 0.4-0.8 m below it. Kept out of
+/// presets() so the suites that run every preset keep their figures.
+const std::vector<PresetInfo>& rig_presets();
 /// A preset or walk by name; nullptr when there is none.
 const PresetInfo* find_preset_info(const std::string& name);
 

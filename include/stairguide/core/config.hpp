@@ -118,11 +118,26 @@ struct SegmentationConfig {
 };
 
 struct FloorConfig {
-  float tilt_min = 0.34906585f;   ///< rad, camera pitch below horizontal (20 deg)
-  float tilt_max = 1.22173048f;   ///< rad (70 deg)
+  // The rig range: any chest or waist rig (issue 34), a camera mounted 0.5-1.8 m high and tilted
+  // 15-80 deg, with a margin for the wobble of a walk (the chest pitches by +-5 deg, the camera
+  // bobs by cm). The paper's 1.0-1.6 m and 20-70 deg gate is the profile config/profiles/paper.yaml.
+  float tilt_min = 0.17453293f;   ///< rad, camera pitch below horizontal (10 deg)
+  float tilt_max = 1.48352986f;   ///< rad (85 deg)
   float roll_max = 0.34906585f;   ///< rad, |roll| allowed (20 deg)
-  float height_min = 1.0f;        ///< m, camera above the floor
-  float height_max = 1.6f;        ///< m
+  float height_min = 0.4f;        ///< m, camera above the floor
+  float height_max = 1.9f;        ///< m
+  // The usual chest rig (the paper's gate): a cold start looks for the floor here first, and only
+  // when none is found here in the whole rig range; floorless stairs place the user's floor here
+  // while no camera height is learned.
+  float usual_tilt_min = 0.34906585f;  ///< rad (20 deg)
+  float usual_tilt_max = 1.22173048f;  ///< rad (70 deg)
+  float usual_height_min = 1.0f;       ///< m
+  float usual_height_max = 1.6f;       ///< m
+  // The rig model: the user's camera height, learned from the first clear views and held.
+  int rig_learn_frames = 5;             ///< clear views agreeing within rig_height_tolerance that establish it
+  float rig_height_tolerance = 0.10f;   ///< m, once established the floor lies within this of it
+  float rig_tilt_tolerance = 0.17453293f;  ///< rad (10 deg), a walk's wobble about the rig's learned tilt
+  int rig_relearn_frames = 150;         ///< frames of a clear floor at another height (none at the held one) that relearn it
   float search_start = 1.0f;      ///< m, first z_C window for floor points
   float search_step = 0.5f;       ///< m, window growth per attempt
   float search_max = 4.0f;        ///< m, largest window
@@ -163,6 +178,27 @@ struct FloorConfig {
     v.num(roll_max, "roll_max_deg", Unit::kDegree, 0, 90, "largest camera roll");
     v.num(height_min, "height_min_m", Unit::kMetre, 0.1, 3, "camera height above the floor: lowest");
     v.num(height_max, "height_max_m", Unit::kMetre, 0.1, 3, "camera height above the floor: highest");
+    v.num(usual_tilt_min, "usual_tilt_min_deg", Unit::kDegree, 0, 90,
+          "the usual chest rig's pitch below horizontal, lowest: a cold start looks for the floor within the usual "
+          "tilt and height first, in the whole range above only when none is found there");
+    v.num(usual_tilt_max, "usual_tilt_max_deg", Unit::kDegree, 0, 90, "the usual chest rig's pitch: highest");
+    v.num(usual_height_min, "usual_height_min_m", Unit::kMetre, 0.1, 3,
+          "the usual chest rig's height above the floor, lowest (also where floorless stairs place the user's floor "
+          "while no camera height is learned)");
+    v.num(usual_height_max, "usual_height_max_m", Unit::kMetre, 0.1, 3, "the usual chest rig's height: highest");
+    v.num(rig_learn_frames, "rig_learn_frames", Unit::kCount, 1, 1000,
+          "the user's camera height is established when this many clear views of the floor (nothing lower nearer the "
+          "user, no possible tread) agree within rig_height_tolerance_cm; meanwhile any height in the range is tried");
+    v.num(rig_height_tolerance, "rig_height_tolerance_cm", Unit::kCentimetre, 2, 50,
+          "once the camera height is established the floor is looked for only this near it (a table, bed, seat or "
+          "landing below the camera is no floor whatever the rig); keep it below the lowest riser or seat");
+    v.num(rig_tilt_tolerance, "rig_tilt_tolerance_deg", Unit::kDegree, 2, 45,
+          "the rig's tilt is learned with its height; from then on a floor outside the usual tilt is taken only "
+          "this near the rig's own (a hand-held camera that now and then grazes the floor is no level rig)");
+    v.num(rig_relearn_frames, "rig_relearn_frames", Unit::kCount, 1, 100000,
+          "frames in which a fresh start would find a clear floor at one other height, with none at the held one, "
+          "that relearn the camera height (the wearer sat down, the rig was remounted); a lower floor needs no level "
+          "in view between it and the camera");
     v.num(search_start, "search_start_m", Unit::kMetre, 0.2, 10, "first forward window searched for floor");
     v.num(search_step, "search_step_m", Unit::kMetre, 0.05, 10, "window growth per attempt");
     v.num(search_max, "search_max_m", Unit::kMetre, 0.2, 20, "largest forward window");

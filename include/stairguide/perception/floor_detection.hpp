@@ -1,9 +1,21 @@
 #pragma once
 /// \file floor_detection.hpp
 /// Camera-to-floor transform (paper 3.2.1). The floor is chosen among the planar regions:
-///  - its normal must fit a chest camera: tilt (optical axis below horizontal) within
+///  - its normal must fit a chest or waist rig: tilt (optical axis below horizontal) within
 ///    [tilt_min, tilt_max] and |roll| <= roll_max;
-///  - the camera must be height_min..height_max above it;
+///  - the camera must be height_min..height_max above it (the rig range, issue 34);
+/// The rig model (issue 34): the user's camera height is a property of the wearer and the rig, not
+/// of the place. A cold start looks in the usual chest band (usual_height_*, usual_tilt_*: the
+/// paper's 1.0-1.6 m, 20-70 deg) first, where one clear view is a floor; outside it (a waist rig,
+/// a steep or level one) only once rig_learn_frames clear views agree within
+/// rig_height_tolerance (one view of a worktop or a bed filling the view looks like a waist rig's
+/// floor). Once established the height is held: outside the usual band a floor is taken only
+/// within rig_height_tolerance of it, so a table, bed, seat or landing below the camera is never
+/// the floor; a height held within the band leaves the band's choice as it was (the traversal's
+/// drift correction depends on it) and keeps what lies outside the band from being the floor. When a fresh start would take a clear floor at one other height for rig_relearn_frames
+/// frames with none at the held height in between (the wearer sat down, the rig was remounted),
+/// that height is relearned; a floor lower than held only when no level lies in view between it
+/// and the camera (on a stair the treads nearer the camera are in view).
 ///  - it must be near the user: the search window on z_C starts at search_start and grows by
 ///    search_step up to search_max; the first window in which some candidate has min_area of
 ///    footprint wins, and among the candidates the one with the largest footprint in it.
@@ -76,10 +88,36 @@ class FloorDetector {
     prev_.reset();
     anchor_.reset();
     lost_frames_ = 0;
+    rig_height_.reset();
+    rig_tilt_.reset();
+    learn_.clear();
+    relearn_.clear();
+    relearn_misses_ = 0;
   }
   const FloorConfig& config() const { return cfg_; }
-  /// Camera height above the floor last verified on a clear view, while remembered; 0 when unknown.
+  /// Camera height above the floor last verified on a clear view, while remembered; else the
+  /// user's camera height the rig model holds; 0 when unknown.
   float remembered_height() const { return anchor_ ? *anchor_ : 0.f; }
+  /// The user's camera height above what they stand on, learned from the first clear views and
+  /// held (relearned when clearly wrong for long); 0 while not yet established.
+  float rig_height() const { return rig_height_ ? *rig_height_ : 0.f; }
+  /// The rig's tilt (rad), learned with its height; 0 while not yet established.
+  float rig_tilt() const { return rig_tilt_ ? *rig_tilt_ : 0.f; }
+  /// The learned rig alone (no tracked floor), to carry over a rebuild of the detector (a config
+  /// reload must not make a waist rig's wearer wait rig_learn_frames views for the floor again).
+  struct Rig {
+    std::optional<float> height, tilt;
+    int learned = 0;
+  };
+  Rig rig() const { return Rig{rig_height_, rig_tilt_, rig_learned_}; }
+  void restore_rig(const Rig& r) {
+    rig_height_ = r.height;
+    rig_tilt_ = r.tilt;
+    rig_learned_ = r.learned;
+  }
+  /// How many times the rig has been established or relearned since construction (a reset too
+  /// counts nothing): tells a listener that rig_height()/rig_tilt() were learned anew.
+  int rig_learned() const { return rig_learned_; }
   /// Frames since the floor was last found; -1 when no floor is remembered.
   int frames_since_floor() const { return prev_ ? lost_frames_ : -1; }
 
@@ -90,7 +128,32 @@ class FloorDetector {
     float angle = 1.6f;     // rad from the nadir to the plane's near edge
   };
   Reach reach(const PlaneRegion& r);
-  FloorEstimate& lost(FloorEstimate& est);
+  void lost(FloorEstimate& est);
+  // One choice of the floor among the planes height_lo..height_hi below the camera; no state
+  // changes but clear_height_ (the height of a floor found on a clear view). probe_: as on a
+  // fresh start, nothing tracked.
+  FloorEstimate select(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame, float height_lo,
+                       float height_hi, float tilt_lo, float tilt_hi);
+  bool refused_as_tread_ = false;  // select() refused a plane as a possible tread (or the user above it)
+  void learn(float height, float tilt);
+  struct TiltBand {
+    float lo, hi;  // rad
+  };
+  // The tilts a floor may be seen at: the whole rig range until the rig's tilt is learned, then
+  // the usual band widened to the rig's tilt +- rig_tilt_tolerance.
+  TiltBand rig_tilt_band() const;
+  bool probe_ = false;
+  std::optional<float> clear_height_;
+  // The rig model: the user's camera height (held), the clear views that establish it, and the
+  // clear views at another height that relearn it (with the frames since the last of them).
+  std::optional<float> rig_height_;
+  int rig_learned_ = 0;
+  std::optional<float> rig_tilt_;  // rad, the median tilt of the views that established the height
+  struct RigView {
+    float height, tilt;
+  };
+  std::vector<RigView> learn_, relearn_;
+  int relearn_misses_ = 0;
   int lost_frames_ = 0;
   void sample_frame(const RgbdFrame& frame);
   bool nothing_below(const PlaneRegion& r, const Reach& near) const;

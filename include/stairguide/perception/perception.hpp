@@ -89,6 +89,10 @@ class Perception {
   const std::vector<int>& labels() const { return segmentation_.labels(); }
   const Segmentation& segmentation() const { return segmentation_; }
   const FloorEstimate& last_floor() const { return floor_est_; }
+  /// The floor detector, with the user's camera height it holds (rig_height()).
+  const FloorDetector& floor_detector() const { return floor_; }
+  /// Takes over a rig learned by another detector (FloorDetector::restore_rig).
+  void restore_rig(const FloorDetector::Rig& rig) { floor_.restore_rig(rig); }
 
  private:
   Segmentation segmentation_;

@@ -54,6 +54,11 @@ struct PerceptionOutput {
   bool manhattan_found = false;
   bool manhattan_carried = false;
   float manhattan_yaw = 0.f;  ///< rad, k_M from the floor frame's forward axis
+  /// The wearer's rig as the floor detector has learned it (camera height above what the user stands
+  /// on, and its tilt); 0 while not yet established.
+  float rig_height_m = 0.f;
+  float rig_tilt_rad = 0.f;
+  int rig_learned = 0;  ///< FloorDetector::rig_learned(): changes when the rig is learned anew
   /// The typed results: what the feedback room reads (as numbers, not from `detail`).
   StairSummary stair;
   TraversalResult traversal;  ///< the traversal tracker (stairs/traversal.hpp); `ran` false when traversal.enabled is off
