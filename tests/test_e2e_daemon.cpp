@@ -2,19 +2,14 @@
 // NOTIFY_SOCKET on a test datagram socket (READY / WATCHDOG / STATUS), its per-frame lines,
 // SIGTERM, SIGHUP with a valid and an invalid config, a replay that ends, a corrupt recording, an
 // unreadable config; and the systemd unit (verify prints nothing, security rating <= 2.5).
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -23,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon_test_util.hpp"
 #include "stairguide/capture/oni.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/config/config_loader.hpp"
@@ -71,147 +67,17 @@ int run_capture(const std::string& cmd, std::string& out) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-/// stairguided as a child process: stdout through a pipe (the frame lines), stderr to a file,
-/// NOTIFY_SOCKET on an abstract datagram socket of this test.
-class Daemon {
- public:
-  Daemon(const std::vector<std::string>& args, const std::string& name,
-         std::uint64_t watchdog_usec = 300000) {
-    static int counter = 0;
-    notify_name_ = "stairguide-test-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
-    notify_fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un addr{};
-    addr.sun_family = AF_UNIX;
-    std::memcpy(addr.sun_path + 1, notify_name_.data(), notify_name_.size());  // abstract namespace
-    const socklen_t len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + notify_name_.size());
-    if (bind(notify_fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) ADD_FAILURE() << "bind notify socket";
-    stderr_path_ = kDir / (name + ".stderr");
-    int out_pipe[2];
-    if (pipe2(out_pipe, O_CLOEXEC) != 0) ADD_FAILURE() << "pipe";
-    pid_ = fork();
-    if (pid_ == 0) {
-      dup2(out_pipe[1], 1);
-      const int err = open(stderr_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(err, 2);
-      setenv("NOTIFY_SOCKET", ("@" + notify_name_).c_str(), 1);
-      if (watchdog_usec) setenv("WATCHDOG_USEC", std::to_string(watchdog_usec).c_str(), 1);
-      unsetenv("WATCHDOG_PID");
-      unsetenv("JOURNAL_STREAM");
-      std::vector<char*> argv;
-      static std::string exe = STAIRGUIDED;
-      argv.push_back(exe.data());
-      std::vector<std::string> copy = args;
-      for (auto& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(exe.c_str(), argv.data());
-      _exit(127);
-    }
-    close(out_pipe[1]);
-    out_fd_ = out_pipe[0];
-  }
-  ~Daemon() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGKILL);
-      int st = 0;
-      waitpid(pid_, &st, 0);
-    }
-    if (out_fd_ >= 0) close(out_fd_);
-    if (notify_fd_ >= 0) close(notify_fd_);
-  }
+using sgtest::Daemon;
 
-  /// Next stdout line, or false at EOF / timeout. Notifications arriving meanwhile are kept.
-  bool read_line(std::string& line, double timeout_s = 20.0) {
-    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
-    for (;;) {
-      const auto nl = buf_.find('\n');
-      if (nl != std::string::npos) {
-        line = buf_.substr(0, nl);
-        buf_.erase(0, nl + 1);
-        return true;
-      }
-      if (eof_) return false;
-      const int ms =
-          static_cast<int>(std::chrono::duration<double, std::milli>(deadline - Clock::now()).count());
-      if (ms <= 0) return false;
-      pump(ms);
-    }
-  }
-
-  /// Waits until a notification containing `text` has arrived (or was already received).
-  bool wait_notify(const std::string& text, double timeout_s = 20.0) {
-    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
-    for (;;) {
-      if (count_notify(text) > 0) return true;
-      const int ms =
-          static_cast<int>(std::chrono::duration<double, std::milli>(deadline - Clock::now()).count());
-      if (ms <= 0) return false;
-      pump(std::min(ms, 100));
-    }
-  }
-  int count_notify(const std::string& text) const {
-    int n = 0;
-    for (const auto& m : notes_)
-      if (m.find(text) != std::string::npos) ++n;
-    return n;
-  }
-  const std::vector<std::string>& notes() const { return notes_; }
-
-  void signal(int sig) { kill(pid_, sig); }
-
-  /// Reads everything left on stdout and waits for exit; returns the exit code (-1 on a signal or
-  /// timeout). `lines` gets the remaining stdout lines.
-  int wait_exit(double timeout_s, std::vector<std::string>* lines = nullptr) {
-    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
-    for (;;) {
-      std::string l;
-      while (read_line(l, 0.0))
-        if (lines) lines->push_back(l);
-      int st = 0;
-      const pid_t r = waitpid(pid_, &st, WNOHANG);
-      if (r == pid_) {
-        exited_ = true;
-        std::string l2;
-        while (read_line(l2, 1.0))
-          if (lines) lines->push_back(l2);
-        pump(10);
-        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-      }
-      if (Clock::now() > deadline) return -1;
-      pump(10);
-    }
-  }
-
-  std::string stderr_text() const { return read_file(stderr_path_); }
-
- private:
-  void pump(int ms) {
-    std::vector<pollfd> fds;
-    if (!eof_) fds.push_back({out_fd_, POLLIN, 0});
-    fds.push_back({notify_fd_, POLLIN, 0});
-    poll(fds.data(), fds.size(), std::max(ms, 0));
-    if (!eof_ && (fds[0].revents & (POLLIN | POLLHUP | POLLERR))) {
-      char b[4096];
-      const ssize_t k = ::read(out_fd_, b, sizeof b);
-      if (k > 0)
-        buf_.append(b, static_cast<std::size_t>(k));
-      else
-        eof_ = true;
-    }
-    for (;;) {
-      char b[4096];
-      const ssize_t k = recv(notify_fd_, b, sizeof b, MSG_DONTWAIT);
-      if (k <= 0) break;
-      notes_.emplace_back(b, static_cast<std::size_t>(k));
-    }
-  }
-
-  pid_t pid_ = -1;
-  int out_fd_ = -1, notify_fd_ = -1;
-  bool eof_ = false, exited_ = false;
-  std::string buf_, notify_name_;
-  fs::path stderr_path_;
-  std::vector<std::string> notes_;
-};
+/// A replay's daemon: stdout (the frame lines) through a pipe, stderr to kDir/<name>.stderr, the
+/// watchdog on at 0.3 s.
+sgtest::DaemonOptions io(const std::string& name) {
+  sgtest::DaemonOptions o;
+  o.out = sgtest::Stdout::pipe;
+  o.err_path = (kDir / (name + ".stderr")).string();
+  o.env = {{"WATCHDOG_USEC", "300000"}};
+  return o;
+}
 
 class DaemonE2E : public ::testing::Test {
  protected:
@@ -254,7 +120,7 @@ fs::path DaemonE2E::oni_, DaemonE2E::config_;
 }  // namespace
 
 TEST_F(DaemonE2E, ReplayNotifiesReadyWatchdogStatusPrintsFramesAndStopsOnSigterm) {
-  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--realtime"}, "sigterm");
+  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--realtime"}, io("sigterm"));
   ASSERT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
   std::vector<std::string> lines;
   std::string l;
@@ -298,7 +164,7 @@ TEST_F(DaemonE2E, ReplayNotifiesReadyWatchdogStatusPrintsFramesAndStopsOnSigterm
 }
 
 TEST_F(DaemonE2E, ReplayThatEndsExitsZeroWithEveryFrameThroughOdometry) {
-  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--fast"}, "ends");
+  Daemon d({"--config", config_.string(), "--replay", oni_.string(), "--fast"}, io("ends"));
   std::vector<std::string> lines;
   const int code = d.wait_exit(120.0, &lines);
   ASSERT_EQ(code, 0) << d.stderr_text();
@@ -333,7 +199,7 @@ TEST_F(DaemonE2E, ReplayThatEndsExitsZeroWithEveryFrameThroughOdometry) {
 TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {
   const fs::path cfg = kDir / "reload.yaml";
   fs::copy_file(config_, cfg, fs::copy_options::overwrite_existing);
-  Daemon d({"--config", cfg.string(), "--replay", oni_.string(), "--realtime"}, "sighup");
+  Daemon d({"--config", cfg.string(), "--replay", oni_.string(), "--realtime"}, io("sighup"));
   ASSERT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
   std::string l;
   ASSERT_TRUE(d.read_line(l));
@@ -370,13 +236,13 @@ TEST_F(DaemonE2E, CorruptOrMissingRecordingFailsWithAClearMessage) {
   const fs::path bad = kDir / "corrupt.oni";
   write_file(bad, std::string(4096, '\x5a'));
   {
-    Daemon d({"--config", config_.string(), "--replay", bad.string()}, "corrupt");
+    Daemon d({"--config", config_.string(), "--replay", bad.string()}, io("corrupt"));
     EXPECT_EQ(d.wait_exit(30.0), 4);
     EXPECT_NE(d.stderr_text().find("corrupt.oni"), std::string::npos) << d.stderr_text();
     EXPECT_EQ(d.count_notify("READY=1"), 0);
   }
   {
-    Daemon d({"--config", config_.string(), "--replay", (kDir / "missing.oni").string()}, "missing");
+    Daemon d({"--config", config_.string(), "--replay", (kDir / "missing.oni").string()}, io("missing"));
     EXPECT_EQ(d.wait_exit(30.0), 4);
     EXPECT_NE(d.stderr_text().find("missing.oni"), std::string::npos) << d.stderr_text();
   }
@@ -384,14 +250,14 @@ TEST_F(DaemonE2E, CorruptOrMissingRecordingFailsWithAClearMessage) {
 
 TEST_F(DaemonE2E, UnreadableOrInvalidConfigIsNamedAndNothingRuns) {
   {
-    Daemon d({"--config", (kDir / "nope.yaml").string(), "--replay", oni_.string()}, "noconfig");
+    Daemon d({"--config", (kDir / "nope.yaml").string(), "--replay", oni_.string()}, io("noconfig"));
     EXPECT_EQ(d.wait_exit(10.0), 3);
     EXPECT_NE(d.stderr_text().find("nope.yaml"), std::string::npos) << d.stderr_text();
   }
   const fs::path bad = kDir / "bad.yaml";
   write_file(bad, "runtime:\n  ring_capacity: 1\n");
   {
-    Daemon d({"--config", bad.string(), "--replay", oni_.string()}, "badconfig");
+    Daemon d({"--config", bad.string(), "--replay", oni_.string()}, io("badconfig"));
     std::vector<std::string> lines;
     EXPECT_EQ(d.wait_exit(10.0, &lines), 3);
     EXPECT_TRUE(lines.empty()) << "no frame may run on a rejected config";

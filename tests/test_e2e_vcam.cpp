@@ -3,21 +3,16 @@
 // staircase; an unplug is logged as camera lost, cued (camera_lost) and put in STATUS; the
 // reconnect attempts follow the back-off (retry_min, doubling, capped at retry_max: asserted from
 // the log's time stamps); after the replug the camera is back and the frames go on.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstring>
+#include <cstdlib>
+#include <fstream>
 #include <regex>
 #include <sstream>
-#include <thread>
 
+#include "daemon_test_util.hpp"
 #include "stairguide/config/config_loader.hpp"
 #include "vcam_test_util.hpp"
 
@@ -29,13 +24,6 @@ namespace {
 
 const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "vcam_test_files";
 constexpr double kRetryMin = 0.2, kRetryMax = 0.8;
-
-std::string read_text(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// A log line of stairguided: "YYYY-mm-dd HH:MM:SS.mmm stairguided LEVEL: text".
 struct LogLine {
@@ -54,49 +42,13 @@ std::vector<LogLine> parse_log(const std::string& log) {
   return out;
 }
 
-/// stairguided on the live camera as a child: stderr (the log) to a file, NOTIFY_SOCKET on an
-/// abstract datagram socket, the virtual camera's environment.
-class LiveDaemon {
+/// stairguided on the live camera: the virtual camera's environment, its log (stderr) to a file
+/// read back by line.
+class LiveDaemon : public sgtest::Daemon {
  public:
   LiveDaemon(const fs::path& config, const fs::path& dataset, const fs::path& control, const fs::path& log)
-      : log_(log) {
-    name_ = "stairguide-vcam-" + std::to_string(getpid());
-    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un addr{};
-    addr.sun_family = AF_UNIX;
-    std::memcpy(addr.sun_path + 1, name_.data(), name_.size());
-    const auto len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + name_.size());
-    if (bind(fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) ADD_FAILURE() << "bind";
-    fs::remove(log);  // an old log must not answer for this run before the child truncates it
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int null = open("/dev/null", O_WRONLY);
-      dup2(null, 1);
-      const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(err, 2);
-      setenv("NOTIFY_SOCKET", ("@" + name_).c_str(), 1);
-      unsetenv("WATCHDOG_USEC");
-      unsetenv("STAIRGUIDE_CONFIG");
-      unsetenv("JOURNAL_STREAM");
-      const char* old = std::getenv("LD_LIBRARY_PATH");
-      setenv("LD_LIBRARY_PATH", (test::vcam_dir() + (old && *old ? std::string(":") + old : "")).c_str(), 1);
-      setenv("SGVCAM_DATASET", dataset.c_str(), 1);
-      setenv("SGVCAM_CONTROL", control.c_str(), 1);
-      std::string exe = STAIRGUIDED, a1 = "--config", a2 = config.string();
-      char* argv[] = {exe.data(), a1.data(), a2.data(), nullptr};
-      execv(exe.c_str(), argv);
-      _exit(127);
-    }
-  }
-  ~LiveDaemon() {
-    if (pid_ > 0 && !reaped_) {
-      kill(pid_, SIGKILL);
-      int st = 0;
-      waitpid(pid_, &st, 0);
-    }
-    close(fd_);
-  }
-  std::string log() const { return read_text(log_); }
+      : Daemon({"--config", config.string()}, options(dataset, control, log)) {}
+  std::string log() const { return stderr_text(); }
   /// Waits until the log has a line containing `text` after the first `skip` such lines; false on
   /// timeout.
   bool wait_log(const std::string& text, double timeout_s, int skip = 0) {
@@ -112,43 +64,18 @@ class LiveDaemon {
     for (const auto& l : parse_log(log())) n += l.text.find(text) != std::string::npos;
     return n;
   }
-  bool wait_notify(const std::string& prefix, double timeout_s) {
-    const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
-    for (;;) {
-      for (const auto& n : notes_)
-        if (n.find(prefix) != std::string::npos) return true;
-      if (Clock::now() >= until) return false;
-      drain(50);
-    }
-  }
-  int stop(double timeout_s) {
-    kill(pid_, SIGTERM);
-    const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
-    while (Clock::now() < until) {
-      int st = 0;
-      if (waitpid(pid_, &st, WNOHANG) == pid_) {
-        reaped_ = true;
-        return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-      }
-      drain(10);
-    }
-    return -1;
-  }
 
  private:
-  void drain(int ms) {
-    pollfd p{fd_, POLLIN, 0};
-    if (poll(&p, 1, ms) <= 0) return;
-    char b[4096];
-    for (ssize_t k; (k = recv(fd_, b, sizeof b, MSG_DONTWAIT)) > 0;)
-      notes_.emplace_back(b, static_cast<std::size_t>(k));
+  static sgtest::DaemonOptions options(const fs::path& dataset, const fs::path& control,
+                                       const fs::path& log) {
+    sgtest::DaemonOptions o;
+    const char* old = std::getenv("LD_LIBRARY_PATH");
+    o.env = {{"LD_LIBRARY_PATH", test::vcam_dir() + (old && *old ? std::string(":") + old : "")},
+             {"SGVCAM_DATASET", dataset.string()},
+             {"SGVCAM_CONTROL", control.string()}};
+    o.err_path = log.string();
+    return o;
   }
-  fs::path log_;
-  std::string name_;
-  int fd_ = -1;
-  pid_t pid_ = -1;
-  bool reaped_ = false;
-  std::vector<std::string> notes_;
 };
 
 }  // namespace
