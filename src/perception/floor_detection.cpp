@@ -731,7 +731,7 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     relearn_misses_ = 0;
     return est;
   }
-  lost(est);
+  lost();
   if (!held) return est;
   // Held, and no floor at the held height. Were the user's height wrong (the wearer sat down, the
   // rig was remounted), a fresh start would take a floor at another height, on a clear view, frame
@@ -837,7 +837,7 @@ FloorDetector::TiltBand FloorDetector::rig_tilt_band() const {
   return b;
 }
 
-void FloorDetector::lost(FloorEstimate&) {
+void FloorDetector::lost() {
   if (prev_ && ++lost_frames_ >= std::max(cfg_.track_hold_frames, cfg_.track_forget_frames)) {
     prev_.reset();
     anchor_.reset();

@@ -128,7 +128,7 @@ class FloorDetector {
     float angle = 1.6f;     // rad from the nadir to the plane's near edge
   };
   Reach reach(const PlaneRegion& r);
-  void lost(FloorEstimate& est);
+  void lost();  // a frame with no floor: the tracked floor is forgotten after track_forget_frames
   // One choice of the floor among the planes height_lo..height_hi below the camera; no state
   // changes but clear_height_ (the height of a floor found on a clear view). probe_: as on a
   // fresh start, nothing tracked.
