@@ -7,6 +7,7 @@
 
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace sgtest {
@@ -41,6 +42,25 @@ struct SynthStairs {
   stairguide::FrameTruth truth;
   stairguide::SceneResult scene;
   stairguide::StairResult result;
+};
+
+/// The world suites' figures: every flight frame scored, the frames with two or more steps fully
+/// visible and those of them detected, and the stair-free frames.
+struct WorldFigures {
+  stairguide::EvalSummary stairs, free;
+  int full_frames = 0, full_detected = 0;
+  /// Scores a flight frame; true when it is a miss worth describing (neither TP, TN nor skipped).
+  bool add_flight(const stairguide::StairResult& r, const stairguide::FrameTruth& truth,
+                  stairguide::StairFrameEval& e) {
+    using stairguide::EvalOutcome;
+    e = stairguide::evaluate_stair_frame(r, truth);
+    stairs.add(e);
+    if (e.fully_visible) {
+      ++full_frames;
+      full_detected += e.outcome == EvalOutcome::kTP;
+    }
+    return e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kTN && e.outcome != EvalOutcome::kSkipped;
+  }
 };
 
 /// One independent view (perception from nothing, as `stairguide eval` runs static presets): the

@@ -14,9 +14,8 @@ namespace {
 
 using namespace stairguide;
 
-struct Figures {
-  EvalSummary stairs, free;
-  int full_frames = 0, full_detected = 0, floor_found = 0;
+struct Figures : sgtest::WorldFigures {
+  int floor_found = 0;
 };
 
 void run_rig(Figures& f, float h, float tilt, synth::RealSensor sensor, std::uint32_t seed, long views,
@@ -32,15 +31,9 @@ void run_rig(Figures& f, float h, float tilt, synth::RealSensor sensor, std::uin
       p.perception.reset();
       for (long k = 0; k < learn; ++k) p.perceive("rig_floor_static", i * 16 + k, seed);
       const StairResult& r = p.step(preset, i, seed);
-      const StairFrameEval e = evaluate_stair_frame(r, p.truth);
-      f.stairs.add(e);
       f.floor_found += p.scene.floor_found;
-      if (e.fully_visible) {
-        ++f.full_frames;
-        f.full_detected += e.outcome == EvalOutcome::kTP;
-      }
-      if (e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kTN &&
-          e.outcome != EvalOutcome::kSkipped) {
+      StairFrameEval e;
+      if (f.add_flight(r, p.truth, e)) {
         const StairTruth* t = p.truth.stairs.empty() ? nullptr : &p.truth.stairs[0];
         std::printf(
             "rig %.1f m %.0f deg seed %u %s #%ld: %s%s (%s) truth riser %.1f tread %.1f; got %d levels "

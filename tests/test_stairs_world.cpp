@@ -20,10 +20,7 @@ using namespace stairguide;
 
 constexpr long kViews = 24;
 
-struct WorldFigures {
-  EvalSummary stairs, free;
-  int full_frames = 0, full_detected = 0;  ///< frames with >= 2 steps fully visible
-};
+using sgtest::WorldFigures;
 
 void run(WorldFigures& f, synth::RealSensor sensor, std::uint32_t seed) {
   sgtest::SynthStairs p;
@@ -31,14 +28,8 @@ void run(WorldFigures& f, synth::RealSensor sensor, std::uint32_t seed) {
   for (const auto& info : synth::world_presets()) {
     for (long i = 0; i < kViews; ++i) {
       const StairResult& r = p.step(info.name, i, seed, /*cold=*/true);
-      const StairFrameEval e = evaluate_stair_frame(r, p.truth);
-      f.stairs.add(e);
-      if (e.fully_visible) {
-        ++f.full_frames;
-        f.full_detected += e.outcome == EvalOutcome::kTP;
-      }
-      if (e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kTN &&
-          e.outcome != EvalOutcome::kSkipped) {
+      StairFrameEval e;
+      if (f.add_flight(r, p.truth, e)) {
         const StairTruth* t = p.truth.stairs.empty() ? nullptr : &p.truth.stairs[0];
         std::printf(
             "%s seed %u %s #%ld: %s%s (%s) truth riser %.1f tread %.1f width %.2f open %d, %zu treads; got "

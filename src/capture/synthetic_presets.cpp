@@ -17,13 +17,17 @@ using V2 = Eigen::Vector2f;
 
 float pick(float v, float fallback) { return std::isnan(v) ? fallback : v; }
 
-// A random chest-camera view from the world origin (the user stands at the origin on the floor),
-// looking roughly along `heading` (rad).
-WalkerState random_view(Rng& rng, const SynthOptions& o, float heading = 0.f, float yaw_range_deg = 25.f) {
-  const float h = pick(o.camera_height_m, rng.uniform(1.0f, 1.6f));
-  const float tilt = deg2rad(pick(o.camera_tilt_deg, rng.uniform(30.f, 60.f)));
+// A view from the world origin (the user stands at the origin on the floor) looking roughly along
+// `heading` (rad), the camera h_lo..h_hi m high and tilted tilt_lo..tilt_hi deg down unless the
+// options fix them; the height and tilt drawn are returned through `height` / `tilt_out`.
+WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo, float tilt_hi,
+                             float heading, float yaw_range_deg, float* height = nullptr, float* tilt_out = nullptr) {
+  const float h = pick(o.camera_height_m, rng.uniform(h_lo, h_hi));
+  const float tilt = deg2rad(pick(o.camera_tilt_deg, rng.uniform(tilt_lo, tilt_hi)));
   const float roll = deg2rad(pick(o.camera_roll_deg, rng.uniform(-3.f, 3.f)));
   const float yaw = heading + deg2rad(rng.uniform(-yaw_range_deg, yaw_range_deg));
+  if (height) *height = h;
+  if (tilt_out) *tilt_out = tilt;
   WalkerState st;
   st.body = V3(0.f, 0.f, 0.f);
   st.yaw = yaw;
@@ -31,6 +35,11 @@ WalkerState random_view(Rng& rng, const SynthOptions& o, float heading = 0.f, fl
   const V3 cam = st.body + 0.12f * V3(std::cos(yaw), std::sin(yaw), 0.f) + V3(0.f, 0.f, h);
   st.T_world_camera = camera_pose(cam, yaw, tilt, roll);
   return st;
+}
+
+// A random chest-camera view from the world origin, looking roughly along `heading` (rad).
+WalkerState random_view(Rng& rng, const SynthOptions& o, float heading = 0.f, float yaw_range_deg = 25.f) {
+  return view_from_origin(rng, o, 1.0f, 1.6f, 30.f, 60.f, heading, yaw_range_deg);
 }
 
 StairParams random_stair(Rng& rng, StairKind kind) {
@@ -740,19 +749,7 @@ namespace {
 // a chest one at 1.8 m looking almost straight down. Drawn from the range the issue asks the
 // floor to cope with, not from the floor detector's gate.
 WalkerState rig_view(Rng& rng, const SynthOptions& o, float* height = nullptr, float* tilt_out = nullptr) {
-  const float h = pick(o.camera_height_m, rng.uniform(0.5f, 1.8f));
-  const float tilt = deg2rad(pick(o.camera_tilt_deg, rng.uniform(15.f, 80.f)));
-  const float roll = deg2rad(pick(o.camera_roll_deg, rng.uniform(-3.f, 3.f)));
-  const float yaw = deg2rad(rng.uniform(-25.f, 25.f));
-  if (height) *height = h;
-  if (tilt_out) *tilt_out = tilt;
-  WalkerState st;
-  st.body = V3(0.f, 0.f, 0.f);
-  st.yaw = yaw;
-  st.support_z = 0.f;
-  const V3 cam = st.body + 0.12f * V3(std::cos(yaw), std::sin(yaw), 0.f) + V3(0.f, 0.f, h);
-  st.T_world_camera = camera_pose(cam, yaw, tilt, roll);
-  return st;
+  return view_from_origin(rng, o, 0.5f, 1.8f, 15.f, 80.f, 0.f, 25.f, height, tilt_out);
 }
 
 // A large horizontal surface 0.4-0.8 m below the camera (lower rigs: a low one, 0.25-0.45 m high),
