@@ -118,39 +118,32 @@ class SyntheticSource final : public FrameSource {
 
 }  // namespace
 
+namespace {
+// The public descriptions of a list of preset definitions.
+std::vector<PresetInfo> infos(const std::vector<detail::PresetDef>& defs) {
+  std::vector<PresetInfo> v;
+  for (const auto& d : defs) v.push_back(d.info);
+  return v;
+}
+}  // namespace
+
 const std::vector<PresetInfo>& presets() {
-  static const std::vector<PresetInfo> list = [] {
-    std::vector<PresetInfo> v;
-    for (const auto& d : detail::preset_defs()) v.push_back(d.info);
-    return v;
-  }();
+  static const std::vector<PresetInfo> list = infos(detail::preset_defs());
   return list;
 }
 
 const std::vector<PresetInfo>& world_presets() {
-  static const std::vector<PresetInfo> list = [] {
-    std::vector<PresetInfo> v;
-    for (const auto& d : detail::world_preset_defs()) v.push_back(d.info);
-    return v;
-  }();
+  static const std::vector<PresetInfo> list = infos(detail::world_preset_defs());
   return list;
 }
 
 const std::vector<PresetInfo>& walk_presets() {
-  static const std::vector<PresetInfo> list = [] {
-    std::vector<PresetInfo> v;
-    for (const auto& d : detail::walk_defs()) v.push_back(d.info);
-    return v;
-  }();
+  static const std::vector<PresetInfo> list = infos(detail::walk_defs());
   return list;
 }
 
 const std::vector<PresetInfo>& rig_presets() {
-  static const std::vector<PresetInfo> list = [] {
-    std::vector<PresetInfo> v;
-    for (const auto& d : detail::rig_defs()) v.push_back(d.info);
-    return v;
-  }();
+  static const std::vector<PresetInfo> list = infos(detail::rig_defs());
   return list;
 }
 
