@@ -3,6 +3,8 @@
 // outputs): the runtime reports it and never invents a result.
 #include "stairguide/runtime/pipeline.hpp"
 
+#include "stairguide/stairs/stair_checks.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -167,7 +169,8 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
       std::snprintf(buf, sizeof buf, "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
                     to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m,
                     m.stair.width_m, m.stair.origin().norm());
-    out.detail = buf;
+    // The building code describes what was found (steep, low risers); it never silenced it.
+    out.detail = std::string(buf) + "; " + code_notes_text(m.stair.code_notes);
   } else if (!m.scene.floor_found) {
     out.state = "no_floor";
     out.detail = m.scene.why.empty() ? "no floor" : m.scene.why;

@@ -1,5 +1,7 @@
 #include "stairguide/stairs/floorless.hpp"
 
+#include "stairguide/stairs/stair_checks.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -479,8 +481,10 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   // floor runs to the user's feet, so its near boundary is the image border; a first step whose
   // nosing is in view is no floor. Cut by the border, a tread shows at most its own depth: a level
   // deeper than the tread measured on the others is the floor. Shallower, nothing in one frame
-  // tells a floor strip from a tread seen from above unless the camera's height rules one out,
-  // and a staircase placed one step off is worse for the user than none: nothing is reported.
+  // tells a floor strip from a tread seen from above unless the camera's height rules one out.
+  // Either way a staircase lies ahead in that direction: it is reported `without_floor` (which
+  // step is the first, and how far, unknown) rather than withheld (issue 39: a wearer standing at
+  // the foot of a flight that fills the view was told nothing).
   if (out.level_data.size() < 2) return;
   {
     const StairLevel& l1 = out.level_data[1];
@@ -515,6 +519,11 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   const bool tread_height = tread_cam >= floor_.usual_height_min - det_.same_level_tolerance &&
                             tread_cam <= floor_.usual_height_max + det_.same_level_tolerance;
   if (!deep && (!chest_view || tread_height)) {
+    // Seen from a wearer's rig (its tilt range) the staircase is told, its first step unknown. A
+    // camera held level (a hand-held or tripod view, no wearer) keeps the old refusal: its model
+    // of a floor strip and open treads came out inconsistent (treads of -39 to 70 cm).
+    const bool rig_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
+    if (rig_view) return;
     out.detected = false;
     out.verdict = StairVerdict::kNoFirstStep;
     return;
@@ -886,24 +895,16 @@ void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrins
     }
   }
   // Validation again, as modelling does, with the tread from the seen edges (none when unknown).
-  const float tol = mod_.dimension_tolerance;
-  const float range = out.T_camera_stair.translation().norm();
-  const float tread_tol = tol + mod_.tread_tolerance_per_m2 * range * range;
-  const float riser = out.riser_m, tread = out.tread_m;
-  out.detected = false;
-  if (riser < mod_.riser_min - tol || riser > mod_.riser_max + tol)
-    out.verdict = StairVerdict::kRiserOutOfRange;
-  else if (edge_k_.size() >= 2 && tread < mod_.tread_min - tread_tol)
-    out.verdict = StairVerdict::kTreadTooShort;
-  else if (edge_k_.size() >= 2 &&
-           (2.f * riser + tread < mod_.blondel_min - tread_tol || 2.f * riser + tread > mod_.blondel_max + tread_tol))
-    out.verdict = StairVerdict::kBlondelOutOfRange;
-  else if (out.width_m < (out.width_complete ? mod_.width_min : 0.5f * mod_.width_min) - tol)
-    out.verdict = StairVerdict::kTooNarrow;
-  else {
-    out.verdict = StairVerdict::kDetected;
-    out.detected = true;
-  }
+  StairDimensions dims;
+  dims.riser = out.riser_m;
+  dims.tread = out.tread_m;
+  dims.tread_known = edge_k_.size() >= 2;
+  dims.width = out.width_m;
+  dims.width_complete = out.width_complete;
+  dims.range = out.T_camera_stair.translation().norm();
+  out.verdict = check_walkable(dims, mod_.dimension_tolerance, mod_.tread_tolerance_per_m2);
+  out.code_notes = describe_against_code(dims, true, mod_);
+  out.detected = out.verdict == StairVerdict::kDetected;
 }
 
 }  // namespace stairguide

@@ -70,6 +70,7 @@ StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, c
   StairFrameEval e;
   e.predicted_kind = r.detected ? r.kind : StairKind::kNone;
   e.predicted_levels = r.detected ? r.levels : 0;
+  e.verdict = r.verdict;
   e.predicted_direction = r.detected ? r.direction() : 0;
   // On the stairs (climbing or descending) the steps are the traversal's business (paper 5), and
   // the first edge lies behind the user: such frames are not scored.
@@ -193,6 +194,7 @@ void EvalSummary::add(const StairFrameEval& e) {
   if (e.wrong_direction) ++wrong_direction;
   // The confusion covers the scored frames (not those skipped): truth kind -> what was reported.
   if (e.outcome != EvalOutcome::kSkipped) ++confusion[e.truth_label()][e.predicted_label()];
+  if (e.outcome != EvalOutcome::kSkipped) ++verdicts[to_string(e.outcome)][to_string(e.verdict)];
   if (e.fully_visible && e.outcome == EvalOutcome::kTP) ++full_tp;
   if (e.fully_visible && e.outcome == EvalOutcome::kFN) ++full_fn;
   if (e.outcome != EvalOutcome::kTP) return;
@@ -232,6 +234,19 @@ std::string summary_json(const EvalSummary& s) {
   kv("kind_ok", json_number(s.kind_ok));
   kv("wrong_direction", json_number(s.wrong_direction));
   kv("recall_fully_visible", json_number(s.recall_fully_visible()));
+  {
+    std::string v = "{";
+    for (const auto& [outcome, row] : s.verdicts) {
+      v += (v.size() > 1 ? ", " : "") + json_quote(outcome) + ": {";
+      bool first = true;
+      for (const auto& [why, n] : row) {
+        v += (first ? "" : ", ") + json_quote(why) + ": " + json_number(n);
+        first = false;
+      }
+      v += "}";
+    }
+    kv("verdicts", v + "}");
+  }
   kv("fully_visible_frames", json_number(s.full_tp + s.full_fn));
   auto stats = [&](const char* name, const ErrorStats& e, const char* unit) {
     const std::string p(name);
@@ -333,6 +348,14 @@ std::string StairEvalTable::to_text() const {
       std::snprintf(line, sizeof line, " %12d", it == row.end() ? 0 : it->second);
       o += line;
     }
+    o += "\n";
+  }
+  // The table of why-nots: each miss and each silent frame with the reason the stage gave.
+  for (const char* outcome : {"FN", "TN"}) {
+    const auto it = all.verdicts.find(outcome);
+    if (it == all.verdicts.end()) continue;
+    o += std::string("why not (") + outcome + "):";
+    for (const auto& [why, n] : it->second) o += " " + std::to_string(n) + " " + why + ";";
     o += "\n";
   }
   o += "errors: mean |error| +- sigma of the signed error, on true positives; width and edge where both ends "

@@ -1,5 +1,7 @@
 #include "stairguide/stairs/stair_modelling.hpp"
 
+#include "stairguide/stairs/stair_checks.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -1167,34 +1169,34 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
         return;
       }
     }
-    if (riser < det_.curb_height_min - tol || riser > cfg_.riser_max + tol) {
+    // A single level's rise: the curb's lowest (a threshold is no curb), up to what a leg climbs.
+    if (riser < det_.curb_height_min - tol || riser > WalkableLimits{}.riser_max + tol) {
       out.verdict = StairVerdict::kRiserOutOfRange;
       return;
     }
+    StairDimensions dims;
+    dims.riser = riser;
+    dims.width = width;
+    dims.width_complete = out.width_complete;
+    dims.range = origin.norm();
+    out.code_notes = describe_against_code(dims, false, cfg_);
     out.verdict = StairVerdict::kDetected;
     out.detected = true;
     return;
   }
   out.kind = dir > 0 ? StairKind::kAscending : StairKind::kDescending;
-  const float tread = out.tread_m;
-  // Edges far away are measured less well (depth noise grows with the square of the distance, and
-  // the tread regions pick up a riser row): the tread's slack grows with it.
-  const float range = origin.norm();
-  const float tread_tol = tol + cfg_.tread_tolerance_per_m2 * range * range;
-  if (riser < cfg_.riser_min - tol || riser > cfg_.riser_max + tol)
-    out.verdict = StairVerdict::kRiserOutOfRange;
-  else if (tread < cfg_.tread_min - tread_tol)
-    out.verdict = StairVerdict::kTreadTooShort;
-  else if (2.f * riser + tread < cfg_.blondel_min - tread_tol || 2.f * riser + tread > cfg_.blondel_max + tread_tol)
-    out.verdict = StairVerdict::kBlondelOutOfRange;
-  else if (width < (out.width_complete ? cfg_.width_min : 0.5f * cfg_.width_min) - tol)
-    out.verdict = StairVerdict::kTooNarrow;
-  else if (!edge_consistent)
-    out.verdict = StairVerdict::kInconsistentEdges;
-  else {
-    out.verdict = StairVerdict::kDetected;
-    out.detected = true;
-  }
+  // Physical evidence only silences a flight (stair_checks.hpp); the building code describes it.
+  StairDimensions dims;
+  dims.riser = riser;
+  dims.tread = out.tread_m;
+  dims.tread_known = true;
+  dims.width = width;
+  dims.width_complete = out.width_complete;
+  dims.range = origin.norm();
+  out.verdict = check_walkable(dims, tol, cfg_.tread_tolerance_per_m2);
+  if (out.verdict == StairVerdict::kDetected && !edge_consistent) out.verdict = StairVerdict::kInconsistentEdges;
+  out.code_notes = describe_against_code(dims, true, cfg_);
+  out.detected = out.verdict == StairVerdict::kDetected;
 }
 
 bool StairModelling::level_stands_on_lower(int n, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,

@@ -22,10 +22,10 @@ const char* to_string(StairVerdict v) {
     case StairVerdict::kNoCandidates: return "no step candidates";
     case StairVerdict::kNoFirstStep: return "no first step connected to the floor";
     case StairVerdict::kObstacle: return "single level too small for a step (obstacle)";
-    case StairVerdict::kRiserOutOfRange: return "riser outside the building code";
-    case StairVerdict::kTreadTooShort: return "tread shorter than the building code";
+    case StairVerdict::kRiserOutOfRange: return "rise not a step's (under 5 or over 25 cm)";
+    case StairVerdict::kTreadTooShort: return "tread too shallow to hold a foot";
     case StairVerdict::kBlondelOutOfRange: return "2R+T outside the building code";
-    case StairVerdict::kTooNarrow: return "narrower than the narrowest staircase";
+    case StairVerdict::kTooNarrow: return "too narrow to walk";
     case StairVerdict::kInconsistentEdges: return "step edges not evenly spaced";
     case StairVerdict::kStackedLevels: return "a level stands on the one below it (an object on a surface)";
   }
@@ -82,6 +82,22 @@ void StairStage::run(const SceneResult& scene, const CameraIntrinsics* K, StairR
     for (StairResult* r : {&up_, &down_}) {
       r->detected = false;
       r->verdict = StairVerdict::kFloorDoubtful;
+    }
+  }
+  // Which level the user stands on is in doubt, which way is up is not: the treads' own vertical
+  // (the floorless route) still tells a staircase that is there, with its first step placed from
+  // the remembered camera height or left unknown (issue 39: doubt about the floor silenced
+  // flights seen from a landing).
+  if (up_.verdict == StairVerdict::kFloorDoubtful && floorless_on_) {
+    floorless_.run(scene, K, out);
+    if (out.detected) {
+      reset(other_, StairVerdict::kFloorDoubtful, d.candidates);
+      const auto t2f = clock::now();
+      auto ms = [](clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
+      out.timings.detection_ms = ms(t1 - t0);
+      out.timings.modelling_ms = ms(t2f - t1);
+      out.timings.total_ms = ms(t2f - t0);
+      return;
     }
   }
   const auto t2 = clock::now();

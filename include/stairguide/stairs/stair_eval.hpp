@@ -53,6 +53,7 @@ struct StairFrameEval {
   bool fully_visible = false;       ///< an expected stair whose first edge is in view with both ends
   bool on_stairs = false;           ///< the user stands on a step (not scored: traversal's frames)
   int predicted_levels = 0;
+  StairVerdict verdict = StairVerdict::kNoCandidates;  ///< the stage's verdict (why not, or kDetected)
   bool has_riser = false, has_tread = false, has_width = false, has_edge = false, has_edge_line = false;
   float riser_err = 0.f, tread_err = 0.f, width_err = 0.f;  ///< m, estimate - truth
   float edge_pos_err = 0.f;   ///< m, distance between estimated and true first-edge centres
@@ -104,6 +105,9 @@ struct EvalSummary {
   /// Scored (not skipped) frames by truth label then reported label (kind_label; "none" when
   /// nothing was detected or no stair was in view).
   std::map<std::string, std::map<std::string, int>> confusion;
+  /// The table of why-nots: scored frames by outcome ("tp", "fn", "fp", "tn") then the stage's
+  /// verdict (to_string(StairVerdict)), so a miss is counted with the reason the software gave.
+  std::map<std::string, std::map<std::string, int>> verdicts;
   int full_tp = 0, full_fn = 0;  ///< TP / FN among frames whose stair is fully visible (first edge, both ends)
   ErrorStats riser, tread, width, edge_pos, edge_line, yaw;
   void add(const StairFrameEval& e);
@@ -121,7 +125,8 @@ struct StairEvalTable {
 
   /// One JSON object: tp, fp, tn, fn, precision, recall, kind_correct, kind_ok, wrong_direction,
   /// riser/tread/width/edge/yaw statistics, the overall `confusion` (truth label -> reported
-  /// label -> frames), by_kind and by_scene objects with the same keys (no confusion).
+  /// label -> frames), the overall `verdicts` (outcome -> verdict -> frames), by_kind and by_scene
+  /// objects with the same keys (no confusion, with verdicts).
   std::string to_json() const;
   /// A human-readable table.
   std::string to_text() const;

@@ -8,6 +8,7 @@
 /// or curb: the edge of the other level nearest the user).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "stairguide/core/ground_truth.hpp"
@@ -32,10 +33,10 @@ enum class StairVerdict {
   kNoCandidates,      ///< no horizontal region at step height
   kNoFirstStep,       ///< no candidate at one riser from the floor and connected to it
   kObstacle,          ///< a single level too small for a step (a box, a seat, a low platform)
-  kRiserOutOfRange,   ///< riser outside the building code
-  kTreadTooShort,     ///< tread shorter than the building code allows (e.g. shelves)
-  kBlondelOutOfRange, ///< 2R + T outside the building code
-  kTooNarrow,         ///< narrower than the narrowest staircase
+  kRiserOutOfRange,   ///< riser outside what a leg climbs (stair_checks.hpp: 5-25 cm), not a step
+  kTreadTooShort,     ///< tread too shallow to hold a foot (stair_checks.hpp: under 15 cm)
+  kBlondelOutOfRange, ///< unused since issue 39: 2R+T only describes (StairResult::code_notes)
+  kTooNarrow,         ///< too narrow for a body (stair_checks.hpp: under 0.4 m)
   kInconsistentEdges, ///< step edges not evenly spaced (not a staircase)
   kStackedLevels      ///< a level stands on the one below it (a box on a shelf board), not a step
 };
@@ -84,6 +85,9 @@ struct StairResult {
   /// and the first seen level's index is then 2 (level_data[k].index counts from the floor).
   bool floor_remembered = false;
   std::vector<StairLevel> level_data;     ///< floor first (index 0), then each step level in order
+  /// How the staircase compares with the configured building code (bits of StairCodeNote in
+  /// stair_checks.hpp; 0 = within code). It describes, it never silences.
+  std::uint32_t code_notes = 0;
   int candidates = 0;                     ///< step candidates considered
   int rejected_candidates = 0;            ///< candidates left out as obstacles (tables, ...)
   StairTimings timings;
@@ -121,6 +125,7 @@ struct StairResult {
     method = StairAxesMethod::kNone;
     without_floor = false;
     floor_remembered = false;
+    code_notes = 0;
     level_data.clear();
     candidates = rejected_candidates = candidates_considered;
   }

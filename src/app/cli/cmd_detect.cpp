@@ -10,6 +10,7 @@
 #include "stairguide/core/json.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/stair_checks.hpp"
 #include "stairguide/stairs/stair_draw.hpp"
 #include "stairguide/stairs/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
@@ -105,6 +106,7 @@ int detect(Context& ctx) {
     kv("floor_found", scene.floor_found ? "true" : "false");
     kv("stair", result.detected ? "true" : "false");
     kv("verdict", quote(to_string(result.verdict)));
+    kv("code", quote(result.detected ? code_notes_text(result.code_notes) : ""));
     kv("kind", quote(to_string(result.kind)));
     // The kind alone does not say which way a curb goes; a curb down taken for one up is a fall.
     kv("direction", quote(direction_name(result.direction())));
@@ -167,6 +169,7 @@ int detect(Context& ctx) {
     std::printf("stair: %s (%s), %d levels seen, riser %.1f cm, tread %.1f cm, width %.1f cm, axes by %s\n",
                 to_string(result.kind), direction_name(result.direction()), result.levels, 100.f * result.riser_m, 100.f * result.tread_m,
                 100.f * result.width_m, to_string(result.method));
+    std::printf("building code: %s\n", code_notes_text(result.code_notes).c_str());
     std::printf("first edge centre (camera frame): %.3f %.3f %.3f m\n", o.x(), o.y(), o.z());
   } else {
     std::printf("stair: none (%s)\n", to_string(result.verdict));
