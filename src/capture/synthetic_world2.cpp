@@ -387,7 +387,8 @@ void sofa_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float L = rng.uniform(1.5f, 2.4f), seat = rng.uniform(0.38f, 0.48f), seat_d = rng.uniform(0.5f, 0.65f);
   const float depth = std::max(seat_d + 0.15f, rng.uniform(0.8f, 1.0f)), back = rng.uniform(0.75f, 0.95f);
   const float arm_h = rng.uniform(0.55f, 0.70f), arm_w = rng.uniform(0.10f, 0.25f), feet = rng.uniform(0.f, 0.15f);
-  const V3 c = furniture_in_view(rng, b.view, 0.5f * std::hypot(L, depth + 0.9f));
+  // The radius takes in a table or ottoman in front (up to 1.2 m before the sofa's front).
+  const V3 c = furniture_in_view(rng, b.view, std::max(0.5f * std::hypot(L, depth), 0.5f * depth + 1.2f));
   const float yaw = facing_wearer(rng, b.view, 0.7f);
   const Pose T = yaw_frame(c, yaw);  // front at x = +depth/2
   const Material m = fabric_material(rng);
@@ -457,15 +458,17 @@ void lowtable_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   room(b.scene, rng);
   b.view = chest_view_ahead(rng, o);
   const float h = rng.uniform(0.35f, 0.50f), len = rng.uniform(0.8f, 1.4f), dep = rng.uniform(0.5f, 0.8f);
-  const Pose T = yaw_frame(furniture_in_view(rng, b.view, 0.5f * std::hypot(len + 0.6f, dep)),
-                           rng.uniform(-kPi, kPi));
   const float hl = 0.5f * len, hd = 0.5f * dep;
-  if (rng.chance(0.4f)) {  // a rug, 1 cm thick
-    const float rl = rng.uniform(1.6f, 2.4f), rd = rng.uniform(1.2f, 1.8f);
+  const bool rug = rng.chance(0.4f);  // a rug, 1 cm thick
+  const float rl = rug ? rng.uniform(1.6f, 2.4f) : 0.f, rd = rug ? rng.uniform(1.2f, 1.8f) : 0.f;
+  const bool nesting = rng.chance(0.25f);  // a smaller, lower nesting table beside it
+  const float h2 = h - rng.uniform(0.05f, 0.12f), s2 = rng.uniform(0.4f, 0.55f);
+  const float radius = std::max({std::hypot(hl + (nesting ? 0.05f + s2 : 0.f), hd), 0.5f * std::hypot(rl, rd)});
+  const Pose T = yaw_frame(furniture_in_view(rng, b.view, radius), rng.uniform(-kPi, kPi));
+  if (rug)
     b.scene.add_box_in(T, V3(-0.5f * rl, -0.5f * rd, 0.f), V3(0.5f * rl, 0.5f * rd, 0.01f), fabric_material(rng),
                        "rug");
-  }
-  const float base = 0.f;
+  const float base = rug ? 0.01f : 0.f;
   const Material m = wood_material(rng);
   const int kind = rng.integer(0, 4);  // 0-2 legs, 3 solid, 4 legs and a shelf
   const float top = rng.uniform(0.02f, 0.05f);
@@ -484,13 +487,12 @@ void lowtable_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
                          "table_shelf");
     }
   }
-  if (rng.chance(0.25f)) {  // a smaller, lower nesting table beside it
-    const float h2 = h - rng.uniform(0.05f, 0.12f), s2 = rng.uniform(0.4f, 0.55f);
+  if (nesting) {
     const float x = hl + 0.05f + 0.5f * s2;
     b.scene.add_box_in(T, V3(x - 0.5f * s2, -0.5f * s2, h2 - 0.02f), V3(x + 0.5f * s2, 0.5f * s2, h2), m, "table");
     for (float i : {-1.f, 1.f})
       for (float j : {-1.f, 1.f})
-        b.scene.add_box_in(T, V3(x + i * (0.5f * s2 - 0.03f) - 0.015f, j * (0.5f * s2 - 0.03f) - 0.015f, 0.f),
+        b.scene.add_box_in(T, V3(x + i * (0.5f * s2 - 0.03f) - 0.015f, j * (0.5f * s2 - 0.03f) - 0.015f, base),
                            V3(x + i * (0.5f * s2 - 0.03f) + 0.015f, j * (0.5f * s2 - 0.03f) + 0.015f, h2 - 0.02f), m,
                            "table_leg");
   }
