@@ -57,9 +57,10 @@ std::map<std::string, int> label_pixels(const synth::PresetFrame& pf, const synt
 }
 
 TEST(StairsWorld2, EveryPresetIsListedAndStatic) {
-  const char* names[] = {"world2_turn_static",    "world2_low_static",      "world2_steep_static",
-                         "world2_shelves_static", "world2_boxes_static",    "world2_sofa_static",
-                         "world2_bench_static",   "world2_lowtable_static", "world2_bed_static"};
+  const char* names[] = {"world2_turn_static",     "world2_low_static",    "world2_steep_static",
+                         "world2_legs_static",     "world2_lowrig_static", "world2_shelves_static",
+                         "world2_boxes_static",    "world2_sofa_static",   "world2_bench_static",
+                         "world2_lowtable_static", "world2_bed_static"};
   for (const char* n : names) {
     EXPECT_TRUE(has_preset(n)) << n;
     const synth::PresetInfo* info = synth::find_preset_info(n);
@@ -217,6 +218,73 @@ TEST(StairsWorld2, SteepFlights) {
   EXPECT_GE(full, 1);
 }
 
+// The wearer's legs: two legs and two feet hang from the body under the camera, the flight's
+// first edge lies beyond the toes (no foot on a step), the camera is tilted 50-80 deg, and the
+// legs are in the rendered view in most views and in every view tilted 65 deg or more.
+TEST(StairsWorld2, LegsInViewBeforeAFlight) {
+  int in_view = 0, views = 0, steep = 0, steep_in_view = 0;
+  for (std::uint32_t seed : kSeeds)
+    for (long i = 0; i < kBuilt; ++i) {
+      const synth::PresetFrame pf = synth::build_preset_frame("world2_legs_static", i, seed);
+      ASSERT_EQ(pf.scene.stairs.size(), 1u);
+      const synth::StairSpec& st = pf.scene.stairs[0];
+      EXPECT_GE(st.riser_m, 0.10f);
+      EXPECT_LE(st.riser_m, 0.22f);
+      int legs = 0, feet = 0;
+      for (const synth::Solid& so : pf.scene.solids()) {
+        legs += so.label == "wearer_leg";
+        if (so.label != "wearer_foot") continue;
+        ++feet;
+        for (int f = so.first_face; f < so.first_face + so.face_count; ++f)
+          for (const Eigen::Vector3f& v : pf.scene.faces()[static_cast<std::size_t>(f)].vertices)
+            EXPECT_EQ(st.tread_under(v), 0) << "a foot on the flight, view " << i;
+      }
+      EXPECT_EQ(legs, 4);  // thigh and shank, twice
+      EXPECT_EQ(feet, 2);
+      EXPECT_EQ(st.tread_under(pf.walker.body), 0);
+      const float tilt = rad2deg(synth::pose_tilt(pf.walker.T_world_camera));
+      EXPECT_GE(tilt, 50.f - 3.5f);  // the roll (+-3 deg) moves the measured tilt a little
+      EXPECT_LE(tilt, 80.f + 3.5f);
+      EXPECT_GE(camera_height(pf), 1.0f - 1e-4f);
+      EXPECT_LE(camera_height(pf), 1.6f + 1e-4f);
+      if (i >= kRendered) continue;
+      const auto px = label_pixels(pf);
+      const int n = (px.count("wearer_leg") ? px.at("wearer_leg") : 0) + (px.count("wearer_foot") ? px.at("wearer_foot") : 0);
+      in_view += n >= 500;
+      ++views;
+      if (tilt >= 65.f) {
+        ++steep;
+        steep_in_view += n >= 500;
+      }
+    }
+  std::printf("legs: in view (>= 500 px) in %d of %d views; %d of %d tilted >= 65 deg\n", in_view, views,
+              steep_in_view, steep);
+  EXPECT_GE(in_view, (views * 6) / 10);
+  EXPECT_EQ(steep_in_view, steep);
+  EXPECT_GE(steep, 3);
+}
+
+// Low rigs: the camera 0.5-0.8 m above the floor, tilted 15-60 deg, before a flight of the codes.
+TEST(StairsWorld2, LowRigBeforeAFlight) {
+  int up = 0, down = 0, low = 0;
+  check_flights("world2_lowrig_static", {0.10f, 0.22f, 0.20f, 0.45f, 0.5f, 0.8f}, low, up, down);
+  EXPECT_EQ(low, 0);
+  EXPECT_GE(up, static_cast<int>(kBuilt / 3));
+  EXPECT_GE(down, static_cast<int>(kBuilt / 3));
+  for (std::uint32_t seed : kSeeds)
+    for (long i = 0; i < kBuilt; ++i) {
+      const synth::PresetFrame pf = synth::build_preset_frame("world2_lowrig_static", i, seed);
+      const float tilt = rad2deg(synth::pose_tilt(pf.walker.T_world_camera));
+      EXPECT_GE(tilt, 15.f - 3.5f);
+      EXPECT_LE(tilt, 60.f + 3.5f);
+    }
+  int full = 0, seen = 0;
+  check_rendered_flights("world2_lowrig_static", full, seen);
+  std::printf("lowrig: %d up, %d down; rendered %d seen, %d fully\n", up, down, seen, full);
+  EXPECT_GE(seen, static_cast<int>(kRendered / 2));
+  EXPECT_GE(full, 1);
+}
+
 // The stair-free presets: no staircase in the scene nor in the truth, the furniture in view
 // (>= 3% of the image) in most views, and its key height in the real range the preset names.
 struct Furniture {
@@ -361,6 +429,16 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
                       preset.c_str(), seed, i, to_string(e.outcome), e.fully_visible ? " fully visible" : "",
                       to_string(e.truth_kind), e.truth_visible_steps, r.detected ? to_string(r.kind) : "-", r.levels,
                       to_string(r.verdict), 100 * r.riser_m, 100 * r.tread_m, p.scene.floor_found);
+          for (const StairTruth& t : p.truth.stairs) {
+            // Where a detection stood against each labelled flight: its origin's distance to the
+            // flight's first edge line (eval matches within 25 cm).
+            const Eigen::Vector3f d = r.T_camera_stair.translation() - t.T_camera_stair.translation();
+            const Eigen::Vector3f x = t.T_camera_stair.linear().col(0);
+            std::printf("       truth %s riser %.1f tread %.1f, %zu treads in view%s%s; detection %.2f m off its edge line\n",
+                        to_string(t.kind), 100 * t.riser_m, 100 * t.tread_m, t.visible_steps.size(),
+                        t.first_edge_visible ? ", first edge" : "", t.both_ends_visible ? " (both ends)" : "",
+                        r.detected ? (d - d.dot(x) * x).norm() : 0.f);
+          }
         }
       }
     }

@@ -35,9 +35,19 @@ WalkerState view_at(Rng& rng, const SynthOptions& o, const V3& body, float yaw, 
   return st;
 }
 
-// A chest camera (1.0-1.6 m, tilted 30-60 deg: the first world's chest range).
+// A camera mounting range: height above the surface stood on (m) and tilt below horizontal (deg).
+struct Rig {
+  float h_lo, h_hi, tilt_lo, tilt_hi;
+};
+constexpr Rig kChest{1.0f, 1.6f, 30.f, 60.f};  // the first world's chest range
+
+WalkerState view_at(Rng& rng, const SynthOptions& o, const V3& body, float yaw, const Rig& rig) {
+  return view_at(rng, o, body, yaw, rig.h_lo, rig.h_hi, rig.tilt_lo, rig.tilt_hi);
+}
+
+// A chest camera (1.0-1.6 m, tilted 30-60 deg).
 WalkerState chest_view(Rng& rng, const SynthOptions& o, const V3& body, float yaw) {
-  return view_at(rng, o, body, yaw, 1.0f, 1.6f, 30.f, 60.f);
+  return view_at(rng, o, body, yaw, kChest);
 }
 
 // A chest view from the world origin, heading within +-25 deg of +x.
@@ -79,13 +89,15 @@ Material ground_material(Rng& rng) { return rng.chance(0.5f) ? concrete_material
 
 // A flight `p` whose first edge lies d_lo..d_hi m ahead of the wearer at the origin (lateral
 // +-0.3 m), indoors (a room around it; a descending flight's walls go down to its foot) or
-// outdoors (open ground, a facade far behind), and a chest view of it.
-void flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p, bool outdoor, float d_lo = 0.8f,
-                  float d_hi = 3.0f) {
+// outdoors (open ground, a facade far behind), and a view of it from `rig`, heading +-25 deg.
+// Returns the flight's index in the scene's stairs.
+int flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p, bool outdoor, float d_lo = 0.8f,
+                 float d_hi = 3.0f, const Rig& rig = kChest) {
   const bool down = p.kind == StairKind::kDescending;
   const float d = rng.uniform(d_lo, d_hi), lat = rng.uniform(-0.3f, 0.3f);
   p.T_world_stair = stair_pose(d, lat, 0.f, down ? 0.f : p.riser_m);
   const float N = static_cast<float>(p.steps);
+  int id = 0;
   if (!down) {
     const float end = d + (N - 1.f) * p.tread_m + p.top_depth_m;
     if (outdoor) {
@@ -94,9 +106,9 @@ void flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p
       const float half = 0.5f * p.width_m + rng.uniform(0.2f, 2.5f);
       floor_and_walls(b.scene, rng, V2(-3.f, -half - 0.5f), V2(end + 0.2f, half + 0.5f));
     }
-    add_staircase(b.scene, p, rng);
+    id = add_staircase(b.scene, p, rng);
   } else {
-    add_staircase(b.scene, p, rng);  // the upper floor and the lower one with it
+    id = add_staircase(b.scene, p, rng);  // the upper floor and the lower one with it
     const float total = N * p.riser_m;
     if (outdoor)
       b.scene.add_box_world(V3(-3.5f, -6.f, -total - 0.3f), V3(-3.2f, 6.f, 3.f), wall_material(rng), "facade");
@@ -104,7 +116,8 @@ void flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p
       add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + N * p.tread_m + 5.f, 4.f), -total - 0.2f, 2.9f + total,
                      wall_material(rng));
   }
-  b.view = chest_view_ahead(rng, o);
+  b.view = view_at(rng, o, V3::Zero(), deg2rad(rng.uniform(-25.f, 25.f)), rig);
+  return id;
 }
 
 // ---- L- and U-shaped stairs seen from their landing ----
@@ -175,8 +188,10 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   up.top_depth_m = rng.uniform(1.2f, 2.5f);
   up.handrails = lo.handrails;
   up.wall_start_m = 0.f;
+  const float len_lo = foot + 2.5f;  // the stairwell runs on 2.5 m past the lower flight's foot
+  // A U's upper floor runs back over the whole stairwell (no void beside the lower flight).
+  if (u_shape) up.top_depth_m = std::max(up.top_depth_m, len_lo + 0.2f - static_cast<float>(n_up - 1) * T);
   const float len_up = static_cast<float>(n_up - 1) * T + up.top_depth_m;
-  const float len_lo = foot + 2.5f;
   if (!u_shape) {
     up.side_walls = true;
     up.T_world_stair = stair_pose(D - hw, s * hw, s * 0.5f * kPi, R);
@@ -189,6 +204,7 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     }
     b.scene.add_box_world(V3(D, std::min(-s * (hw + 0.12f), s * hw), -total_lo),
                           V3(D + 0.12f, std::max(-s * (hw + 0.12f), s * hw), top), wall_m, "wall");
+    b.scene.add_box_world(V3(-len_lo - 0.12f, -hw - 0.12f, -total_lo), V3(-len_lo, hw + 0.12f, top), wall_m, "wall");
   } else {
     const float yc = s * (W + gap);
     up.side_walls = false;
@@ -204,6 +220,7 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     b.scene.add_box_world(V3(-far, ylo - 0.12f, -total_lo), V3(D + 0.12f, ylo, top), wall_m, "wall");
     b.scene.add_box_world(V3(-far, yhi, -total_lo), V3(D + 0.12f, yhi + 0.12f, top), wall_m, "wall");
     b.scene.add_box_world(V3(D, ylo, -total_lo), V3(D + 0.12f, yhi, top), wall_m, "wall");
+    b.scene.add_box_world(V3(-far - 0.12f, ylo - 0.12f, -total_lo), V3(-far, yhi + 0.12f, top), wall_m, "wall");
   }
 
   // The view: on the landing, facing the upper or the lower flight, or turning towards it.
@@ -277,6 +294,124 @@ void steep_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   p.wall_start_m = rng.uniform(-1.5f, 0.f);
   p.top_depth_m = rng.uniform(1.2f, 3.f);
   flight_ahead(rng, o, b, p, false);
+}
+
+// A flight from the codes of the world (riser 10-22 cm, going 20-45 cm, 2R+T 50-72 cm), 2-14
+// steps, narrow (0.65-0.9 m), usual or wide (1.8-2.6 m), nosings on 40%, walls on 60%.
+StairParams code_flight(Rng& rng, StairKind kind) {
+  StairParams p;
+  p.kind = kind;
+  p.steps = rng.integer(2, 14);
+  code_riser_going(rng, p.riser_m, p.tread_m);
+  const float w = rng.uniform();
+  p.width_m =
+      w < 0.25f ? rng.uniform(0.65f, 0.9f) : (w < 0.45f ? rng.uniform(1.8f, 2.6f) : rng.uniform(0.9f, 1.8f));
+  p.nosing_m = rng.chance(0.4f) ? rng.uniform(0.01f, 0.04f) : 0.f;
+  p.side_walls = rng.chance(0.6f);
+  p.handrails = rng.chance(0.5f);
+  p.wall_start_m = rng.uniform(-1.5f, 0.f);
+  p.top_depth_m = rng.uniform(1.2f, 3.f);
+  return p;
+}
+
+// ---- the wearer's own legs ----
+
+// The wearer's legs and feet, standing at the body point `body` facing `yaw`: hips at 0.74 of
+// the camera's height (a chest camera sits at about 0.72 of the stature, the hip joint at 0.53),
+// thighs 7-9 cm and shanks 5-6 cm in radius, shoes 26-31 cm long, 9-11 cm wide, 7-11 cm high;
+// feet 15-30 cm apart, one 0-45 cm ahead of the other (standing, or mid-step).
+void add_wearer_legs(Scene& scene, Rng& rng, const V3& body, float yaw, float camera_h) {
+  const V3 fwd(std::cos(yaw), std::sin(yaw), 0.f), left(-fwd.y(), fwd.x(), 0.f);
+  Material trousers = fabric_material(rng);
+  trousers.albedo *= rng.uniform(0.4f, 0.9f);
+  Material shoe = rng.chance(0.5f) ? fabric_material(rng) : metal_material(rng);
+  shoe.albedo *= rng.uniform(0.3f, 0.8f);
+  const float hip_z = 0.74f * camera_h, spread = rng.uniform(0.15f, 0.30f), ahead = rng.uniform(0.f, 0.45f);
+  const float lead = rng.chance(0.5f) ? 1.f : -1.f;  // the foot ahead: left or right
+  const float r_thigh = rng.uniform(0.07f, 0.09f), r_shank = rng.uniform(0.05f, 0.06f);
+  const float len = rng.uniform(0.26f, 0.31f), wid = rng.uniform(0.09f, 0.11f), hgt = rng.uniform(0.07f, 0.11f);
+  for (float side : {-1.f, 1.f}) {
+    // The ankle 5 cm ahead of the heel; the foot ahead reaches `ahead` further, the other as far
+    // back.
+    const float a = side == lead ? 0.5f * ahead : -0.5f * ahead;
+    const V3 ankle = body + a * fwd + side * 0.5f * spread * left + V3(0.f, 0.f, 0.8f * hgt);
+    const V3 hip = body + side * rng.uniform(0.08f, 0.10f) * left + V3(0.f, 0.f, hip_z);
+    const V3 knee = 0.5f * (hip + ankle) + rng.uniform(0.02f, 0.06f) * fwd;
+    scene.add_cylinder(hip, knee, r_thigh, r_thigh, trousers, "wearer_leg", 12);
+    scene.add_cylinder(knee, ankle, r_shank, r_shank, trousers, "wearer_leg", 10);
+    const float toe_out = deg2rad(rng.uniform(0.f, 15.f)) * side;
+    const float fy = yaw + toe_out;
+    const V3 heel = body + a * fwd + side * 0.5f * spread * left - 0.05f * V3(std::cos(fy), std::sin(fy), 0.f);
+    scene.add_box_in(yaw_frame(heel, fy), V3(0.f, -0.5f * wid, 0.f), V3(len, 0.5f * wid, hgt), shoe, "wearer_foot");
+  }
+}
+
+// The wearer's own legs and feet at the bottom of the view, in front of a flight up or down
+// (codes' range) whose first edge is 2-100 cm beyond the toes; the chest camera tilted 50-80 deg
+// (steeply, as when looking down at the first step: the legs come into view).
+void legs_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  StairParams p = code_flight(rng, rng.chance(0.5f) ? StairKind::kDescending : StairKind::kAscending);
+  const bool down = p.kind == StairKind::kDescending;
+  // The view first (the legs hang from it), then the flight beyond the toes.
+  const Rig rig{1.0f, 1.6f, 50.f, 80.f};
+  b.view = view_at(rng, o, V3::Zero(), 0.f, rig);
+  const float h = b.view.T_world_camera.translation().z();
+  add_wearer_legs(b.scene, rng, V3::Zero(), 0.f, h);
+  const float gap = rng.uniform(0.02f, 1.0f), lat = rng.uniform(-0.2f, 0.2f), psi = deg2rad(rng.uniform(-15.f, 15.f));
+  // The first edge `gap` beyond the foremost point of either shoe, measured along the flight.
+  const V3 n(std::cos(psi), std::sin(psi), 0.f);
+  float d = 0.f;
+  for (const Solid& so : b.scene.solids())
+    if (so.label == "wearer_foot")
+      for (int f = so.first_face; f < so.first_face + so.face_count; ++f)
+        for (const V3& q : b.scene.faces()[static_cast<std::size_t>(f)].vertices)
+          d = std::max(d, (q.dot(n) - lat * n.y() + gap) / n.x());
+  p.T_world_stair = stair_pose(d, lat, psi, down ? 0.f : p.riser_m);
+  const float N = static_cast<float>(p.steps);
+  if (!down) {
+    const float end = d + (N - 1.f) * p.tread_m + p.top_depth_m;
+    const float half = 0.5f * p.width_m + rng.uniform(0.2f, 2.0f);
+    floor_and_walls(b.scene, rng, V2(-3.f, -half - 0.5f), V2(end + 0.5f, half + 0.5f));
+    add_staircase(b.scene, p, rng);
+  } else {
+    add_staircase(b.scene, p, rng);
+    const float total = N * p.riser_m;
+    add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + N * p.tread_m + 5.f, 4.f), -total - 0.2f, 2.9f + total,
+                   wall_material(rng));
+  }
+}
+
+// ---- low rigs: a waist or hip camera ----
+
+// A camera 0.5-0.8 m high (on a belt, a hip, a bag strap), tilted 15-60 deg, looking at a flight
+// up or down drawn from the codes: its first edge 0.4-1.2 times as far as the optical axis meets
+// the floor (0.3-3.0 m), turned +-10 deg from the heading.
+void lowrig_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  StairParams p = code_flight(rng, rng.chance(0.5f) ? StairKind::kDescending : StairKind::kAscending);
+  p.open_risers = p.kind == StairKind::kAscending && rng.chance(0.2f);
+  if (p.open_risers) {
+    p.nosing_m = 0.f;
+    p.side_walls = false;
+  }
+  const bool down = p.kind == StairKind::kDescending;
+  b.view = view_at(rng, o, V3::Zero(), deg2rad(rng.uniform(-25.f, 25.f)), Rig{0.5f, 0.8f, 15.f, 60.f});
+  const float h = b.view.T_world_camera.translation().z(), tilt = std::max(0.2f, pose_tilt(b.view.T_world_camera));
+  const float d = std::clamp(rng.uniform(0.4f, 1.2f) * h / std::tan(tilt), 0.3f, 3.0f);
+  const float yaw = b.view.yaw + deg2rad(rng.uniform(-10.f, 10.f)), lat = rng.uniform(-0.2f, 0.2f);
+  const V3 at = d * V3(std::cos(b.view.yaw), std::sin(b.view.yaw), 0.f) +
+                lat * V3(-std::sin(b.view.yaw), std::cos(b.view.yaw), 0.f);
+  p.T_world_stair = stair_pose(at.x(), at.y(), yaw, down ? 0.f : p.riser_m);
+  const float N = static_cast<float>(p.steps);
+  const float ext = d + N * p.tread_m + p.top_depth_m + 1.5f;  // a room round all of it, whatever the turn
+  if (!down) {
+    floor_and_walls(b.scene, rng, V2(-3.f, -ext), V2(ext, ext));
+    add_staircase(b.scene, p, rng);
+  } else {
+    add_staircase(b.scene, p, rng);
+    const float total = N * p.riser_m;
+    add_room_walls(b.scene, V2(-3.f, -ext - 4.f), V2(ext + 4.f, ext + 4.f), -total - 0.2f, 2.9f + total,
+                   wall_material(rng));
+  }
 }
 
 // ---- stair-free furniture (labels: none) ----
@@ -562,6 +697,11 @@ const std::vector<PresetDef>& world2_defs() {
           "low-riser flights up or down: risers 8-12 cm, goings 30-60 cm, any 2R+T (training stairs, garden steps)",
           low_static),
       def("world2_steep_static", "steep flights up or down: goings 20-24 cm, risers 18-25 cm, narrow", steep_static),
+      def("world2_legs_static",
+          "the wearer's own legs and feet at the bottom of a steep view (tilt 50-80 deg) before a flight up or down",
+          legs_static),
+      def("world2_lowrig_static", "a waist or hip camera (0.5-0.8 m, tilt 15-60 deg) before a flight up or down",
+          lowrig_static),
       def("world2_shelves_static", "bookcases and shelving 0.8-2.0 m high, boards every 25-40 cm, ladder shelves; no stairs",
           shelves_static),
       def("world2_boxes_static", "2-3 stacked boxes, each smaller than the one below (a stair of boxes); no stairs",
