@@ -59,6 +59,7 @@ std::map<std::string, int> label_pixels(const synth::PresetFrame& pf, const synt
 TEST(StairsWorld2, EveryPresetIsListedAndStatic) {
   const char* names[] = {"world2_turn_static",     "world2_low_static",    "world2_steep_static",
                          "world2_legs_static",     "world2_lowrig_static", "world2_shelves_static",
+                         "world2_dressed_static",
                          "world2_boxes_static",    "world2_sofa_static",   "world2_bench_static",
                          "world2_lowtable_static", "world2_bed_static"};
   for (const char* n : names) {
@@ -216,6 +217,91 @@ TEST(StairsWorld2, SteepFlights) {
   EXPECT_GE(down, static_cast<int>(kBuilt / 3));
   EXPECT_GE(seen, static_cast<int>(kRendered / 2));
   EXPECT_GE(full, 1);
+}
+
+// Every labelled tread's top (the highest solid labelled with it: the carpet over a tread, where
+// there is one) lies at the height the label gives it, and an ascending flight's first edge at
+// its first tread's height: the labels follow what was built.
+void check_tread_heights(const synth::Scene& scene, const char* preset, long view) {
+  for (const synth::StairSpec& st : scene.stairs)
+    for (int k = 1; k <= st.steps; ++k) {
+      float top = -1e9f;
+      for (const synth::Solid& so : scene.solids())
+        if (so.stair == st.id && so.tread == k) {
+          for (int f = so.first_face; f < so.first_face + so.face_count; ++f)
+            for (const Eigen::Vector3f& v : scene.faces()[static_cast<std::size_t>(f)].vertices)
+              top = std::max(top, v.z());
+        }
+      if (top > -1e8f) {
+        EXPECT_NEAR(top, st.tread_height(k), 1e-4f) << preset << " view " << view << " tread " << k;
+      }
+    }
+  for (const synth::StairSpec& st : scene.stairs)
+    if (st.kind == StairKind::kAscending) {
+      EXPECT_NEAR(st.T_world_stair.translation().z(), st.tread_height(1), 1e-4f) << preset << " view " << view;
+    }
+}
+
+TEST(StairsWorld2, TreadLabelsAtTheBuiltHeights) {
+  for (const char* preset : {"world2_turn_static", "world2_low_static", "world2_steep_static", "world2_dressed_static",
+                             "world2_legs_static", "world2_lowrig_static"})
+    for (std::uint32_t seed : kSeeds)
+      for (long i = 0; i < kBuilt; ++i) check_tread_heights(synth::build_preset_frame(preset, i, seed).scene, preset, i);
+}
+
+// Dressed flights: the codes' riser and going, the wearer on the floor (on the carpet where there
+// is one), carpet (a pile relief) on some and things standing on treads on others: shoes, bags
+// and boxes 10-40 cm high, each on a tread (its bottom at a tread's height), on 1-3 treads.
+TEST(StairsWorld2, DressedFlightsCarpetAndThings) {
+  int carpeted = 0, with_things = 0, views = 0;
+  for (std::uint32_t seed : kSeeds)
+    for (long i = 0; i < kBuilt; ++i) {
+      const synth::PresetFrame pf = synth::build_preset_frame("world2_dressed_static", i, seed);
+      ASSERT_EQ(pf.scene.stairs.size(), 1u);
+      const synth::StairSpec& st = pf.scene.stairs[0];
+      EXPECT_GE(st.riser_m, 0.10f);
+      EXPECT_LE(st.riser_m, 0.22f);
+      EXPECT_GE(st.tread_m, 0.20f);
+      EXPECT_LE(st.tread_m, 0.45f);
+      EXPECT_NEAR(st.base_z, pf.walker.support_z, 1e-5f);  // the wearer stands on the floor before it
+      EXPECT_EQ(st.tread_under(pf.walker.body), 0);
+      bool carpet = false;
+      std::set<int> treads;
+      for (const synth::Solid& so : pf.scene.solids()) {
+        carpet = carpet || so.material.relief_m > 0.f;
+        if (so.label != "shoe" && so.label != "bag" && so.label != "box") continue;
+        float bottom = 1e9f, top = -1e9f;
+        for (int f = so.first_face; f < so.first_face + so.face_count; ++f)
+          for (const Eigen::Vector3f& v : pf.scene.faces()[static_cast<std::size_t>(f)].vertices) {
+            bottom = std::min(bottom, v.z());
+            top = std::max(top, v.z());
+          }
+        const float h = top - bottom;
+        EXPECT_GE(h, 0.10f - 1e-4f);
+        EXPECT_LE(h, 0.40f + 1e-4f);
+        int on = -1;
+        for (int k = 1; k < st.steps; ++k)
+          if (std::abs(bottom - st.tread_height(k)) < 1e-4f) on = k;
+        EXPECT_GE(on, 1) << "a thing not standing on a tread, view " << i;
+        if (on >= 1) {
+          treads.insert(on);
+          // On the tread: its centre over the tread's depth.
+          const Eigen::Vector3f c = st.T_world_stair.inverse() * so.T_world_solid.translation();
+          EXPECT_EQ(st.tread_under(so.T_world_solid.translation()), on) << "view " << i << " z_S " << c.z();
+        }
+      }
+      EXPECT_LE(treads.size(), 3u);
+      carpeted += carpet;
+      with_things += !treads.empty();
+      EXPECT_TRUE(carpet || !treads.empty()) << "view " << i;
+      ++views;
+    }
+  std::printf("dressed: %d views, %d carpeted, %d with things on the steps\n", views, carpeted, with_things);
+  EXPECT_GE(carpeted, views / 3);
+  EXPECT_GE(with_things, views / 2);
+  int full = 0, seen = 0;
+  check_rendered_flights("world2_dressed_static", full, seen);
+  EXPECT_GE(seen, static_cast<int>(kRendered / 2));
 }
 
 // The wearer's legs: two legs and two feet hang from the body under the camera, the flight's

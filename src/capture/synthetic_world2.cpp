@@ -314,6 +314,160 @@ StairParams code_flight(Rng& rng, StairKind kind) {
   return p;
 }
 
+// ---- dressed flights: carpet, nosings, and things standing on the steps ----
+
+Material cardboard(Rng& rng) {
+  Material m;
+  m.albedo = V3(0.35f, 0.52f, 0.68f) * rng.uniform(0.8f, 1.15f);
+  m.texture = Texture::kPlain;
+  m.contrast = 0.15f;
+  m.texel_m = 0.01f;
+  return m;
+}
+
+
+// Things left on a step (the heights the issue names, 10-40 cm): a pair of shoes or boots, a bag,
+// a box. `k_top` is the tread's height (frame B of the flight), [z_lo, z_hi] its free depth.
+void add_thing_on_tread(Scene& scene, Rng& rng, const Pose& T_wb, float hw, float k_top, float z_lo, float z_hi,
+                        bool against_hi) {
+  if (z_hi - z_lo < 0.08f) return;
+  const int kind = rng.integer(0, 2);
+  // A box w wide (along the step) and dp deep, against one end of [lo, hi] (a gap of 0-3 cm).
+  auto place = [&](float w, float dp, float h, const Material& m, const char* label, float x, float lo, float hi) {
+    dp = std::min(dp, hi - lo);
+    const float gap = std::min(rng.uniform(0.f, 0.03f), hi - lo - dp);
+    const float z1 = against_hi ? hi - gap : lo + gap + dp;
+    scene.add_box_in(T_wb, V3(x - 0.5f * w, k_top, z1 - dp), V3(x + 0.5f * w, k_top + h, z1), m, label);
+  };
+  auto lateral = [&](float w) { return std::max(0.f, hw - 0.5f * w) * rng.uniform(-1.f, 1.f); };
+  if (kind == 0) {  // a pair of shoes (boots one time in three)
+    const float len = rng.uniform(0.24f, 0.31f), wid = rng.uniform(0.08f, 0.11f);
+    const float h = rng.chance(0.33f) ? rng.uniform(0.20f, 0.35f) : rng.uniform(0.10f, 0.14f);
+    Material m = rng.chance(0.5f) ? fabric_material(rng) : wood_material(rng);
+    m.albedo *= 0.5f;
+    if (z_hi - z_lo < len + 0.02f || rng.chance(0.5f)) {  // lying along the step, one before the other
+      const float x = lateral(len);
+      place(len, wid, h, m, "shoe", x, z_lo, z_hi);
+      if (z_hi - z_lo >= 2.f * wid + 0.03f) {
+        const float shift = wid + 0.01f;
+        place(len, wid, h, m, "shoe", x, against_hi ? z_lo : z_lo + shift, against_hi ? z_hi - shift : z_hi);
+      }
+    } else {  // side by side, pointing into the step
+      const float x = lateral(2.f * wid + 0.03f);
+      place(wid, len, h, m, "shoe", x - 0.5f * wid - 0.015f, z_lo, z_hi);
+      place(wid, len, h, m, "shoe", x + 0.5f * wid + 0.015f, z_lo, z_hi);
+    }
+  } else if (kind == 1) {  // a bag
+    const float w = rng.uniform(0.25f, 0.45f), dp = rng.uniform(0.10f, 0.25f), h = rng.uniform(0.20f, 0.40f);
+    place(w, dp, h, fabric_material(rng), "bag", lateral(w), z_lo, z_hi);
+  } else {  // a box
+    const float w = rng.uniform(0.15f, 0.40f), dp = rng.uniform(0.15f, 0.35f), h = rng.uniform(0.10f, 0.40f);
+    place(w, dp, h, cardboard(rng), "box", lateral(w), z_lo, z_hi);
+  }
+}
+
+// A carpet of the palette of stair carpets, its pile a relief of 2-4 mm.
+Material carpet_material(Rng& rng) {
+  const V3 palettes[4] = {V3(0.30f, 0.25f, 0.40f), V3(0.25f, 0.30f, 0.25f), V3(0.45f, 0.45f, 0.50f),
+                          V3(0.20f, 0.20f, 0.45f)};
+  Material m;
+  m.albedo = palettes[rng.integer(0, 3)] * rng.uniform(0.8f, 1.2f);
+  m.texture = Texture::kCarpet;
+  m.contrast = rng.uniform(0.3f, 0.5f);
+  m.texel_m = rng.uniform(0.003f, 0.005f);
+  m.relief_m = rng.uniform(0.002f, 0.004f);
+  return m;
+}
+
+// Dressed flights, up or down, of the codes' range, indoors: on 60% a fitted carpet 8-15 mm thick
+// (pile relief 2-4 mm) over the floor, the treads and the risers, wrapped round each nosing
+// (1.5-3.5 cm) as a rounded bull nose of 2.3-3 cm radius; on 75% of the carpeted flights and on all
+// the others, shoes, bags or boxes (10-40 cm high) standing on 1-3 treads. The labels keep the
+// flight's riser and going; its first edge is the front of the first bull nose, at the carpet's
+// height.
+void dressed_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  const bool down = rng.chance(0.5f);
+  StairParams p = code_flight(rng, down ? StairKind::kDescending : StairKind::kAscending);
+  p.steps = rng.integer(3, 14);
+  p.open_risers = false;
+  const bool carpet = rng.chance(0.6f);
+  const bool things = !carpet || rng.chance(0.75f);
+  if (carpet) p.nosing_m = rng.uniform(0.015f, 0.035f);
+  const float c = carpet ? rng.uniform(0.008f, 0.015f) : 0.f;
+  const Material cm = carpet_material(rng);
+  const float d = rng.uniform(0.8f, 3.0f), lat = rng.uniform(-0.3f, 0.3f);
+  const float R = p.riser_m, T = p.tread_m, n = p.nosing_m, hw = 0.5f * p.width_m;
+  const int N = p.steps;
+  p.T_world_stair = stair_pose(d, lat, 0.f, down ? 0.f : R);
+  const float top_z0 = static_cast<float>(N - 1) * T, top_end = top_z0 + p.top_depth_m;
+  int id = 0;
+  if (!down) {
+    const float half = 0.5f * p.width_m + rng.uniform(0.2f, 2.5f), end = d + top_end;
+    floor_and_walls(b.scene, rng, V2(-3.f, -half - 0.5f), V2(end + 0.2f, half + 0.5f));
+    id = add_staircase(b.scene, p, rng);
+    if (carpet) b.scene.add_box_world(V3(-3.f, -half - 0.5f, 0.f), V3(end + 0.2f, half + 0.5f, c), cm, "carpet");
+  } else {
+    id = add_staircase(b.scene, p, rng);
+    add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + static_cast<float>(N) * T + 5.f, 4.f),
+                   -static_cast<float>(N) * R - 0.2f, 2.9f + static_cast<float>(N) * R, wall_material(rng));
+  }
+  // Frame B of the flight: the stair frame moved down to the floor before its first edge.
+  Pose T_wb = p.T_world_stair;
+  T_wb.translation() = p.T_world_stair * V3(0.f, down ? 0.f : -R, 0.f);
+  const float rn = 0.015f + c;  // the bull nose's radius, round the 3 cm nosing slab's mid line
+  auto nose = [&](float y_top, float z, float half_w) {
+    b.scene.add_cylinder(T_wb * V3(-half_w, y_top - 0.015f, z), T_wb * V3(half_w, y_top - 0.015f, z), rn, rn, cm,
+                         "carpet", 16);
+  };
+  if (carpet && !down) {
+    for (int k = 1; k <= N; ++k) {
+      const float z0 = static_cast<float>(k - 1) * T, z1 = k < N ? static_cast<float>(k) * T : top_end;
+      const float y = static_cast<float>(k) * R;
+      b.scene.add_box_in(T_wb, V3(-hw, y, z0 + 0.015f), V3(hw, y + c, z1 + n), cm, "carpet", id, k);
+      nose(y, z0 + 0.015f, hw);
+      b.scene.add_box_in(T_wb, V3(-hw, y - R + c, z0 + n - c), V3(hw, y - 0.03f, z0 + n), cm, "carpet");
+    }
+  } else if (carpet) {
+    const float total = static_cast<float>(N) * R, side = p.side_walls ? hw : 6.f;
+    b.scene.add_box_in(T_wb, V3(-6.f, 0.f, -8.f), V3(6.f, c, -0.015f), cm, "carpet");
+    nose(0.f, -0.015f, side);
+    for (int k = 1; k < N; ++k) {
+      const float z0 = static_cast<float>(k - 1) * T, y = -static_cast<float>(k) * R;
+      b.scene.add_box_in(T_wb, V3(-hw, y, z0 - n), V3(hw, y + c, z0 + T - 0.015f), cm, "carpet", id, k);
+      nose(y, z0 + T - 0.015f, hw);
+    }
+    b.scene.add_box_in(T_wb, V3(-6.f, -total, top_z0 - n), V3(6.f, -total + c, top_z0 + 8.f), cm, "carpet", id, N);
+    if (p.side_walls)  // the upper floor beside the flight
+      for (float sd : {-1.f, 1.f})
+        b.scene.add_box_in(T_wb, V3(sd > 0 ? hw : -6.f, 0.f, -0.015f), V3(sd > 0 ? 6.f : -hw, c, top_z0 + 4.f), cm,
+                           "carpet");
+  }
+  if (carpet) {  // the labels: every level is c higher, the first edge is the bull nose's front
+    StairSpec& sp = b.scene.stairs[static_cast<std::size_t>(id)];
+    sp.base_z += c;
+    sp.T_world_stair.translation() += V3(0.f, 0.f, c) + (down ? c : -c) * sp.T_world_stair.linear().col(2);
+  }
+  if (things) {
+    std::vector<int> treads;
+    for (int k = 1; k < N; ++k) treads.push_back(k);
+    for (int i = 0, m = rng.integer(1, std::min(3, N - 1)); i < m && !treads.empty(); ++i) {
+      const std::size_t j = static_cast<std::size_t>(rng.integer(0, static_cast<int>(treads.size()) - 1));
+      const int k = treads[j];
+      treads.erase(treads.begin() + static_cast<std::ptrdiff_t>(j));
+      const float z0 = static_cast<float>(k - 1) * T;
+      for (int q = 0, per = rng.integer(1, 2); q < per; ++q) {
+        if (!down)  // from the nose to the next riser, against the riser
+          add_thing_on_tread(b.scene, rng, T_wb, hw, static_cast<float>(k) * R + c, z0 + 0.03f + c, z0 + T + n - c,
+                             true);
+        else  // from the riser above to the nose, against the riser
+          add_thing_on_tread(b.scene, rng, T_wb, hw, -static_cast<float>(k) * R + c, z0 - n, z0 + T - 0.03f - c,
+                             false);
+      }
+    }
+  }
+  b.view = chest_view(rng, o, V3(0.f, 0.f, c), deg2rad(rng.uniform(-25.f, 25.f)));
+}
+
 // ---- the wearer's own legs ----
 
 // The wearer's legs and feet, standing at the body point `body` facing `yaw`: hips at 0.74 of
@@ -432,14 +586,6 @@ float facing_wearer(Rng& rng, const WalkerState& view, float spread) {
   return view.yaw + kPi + rng.uniform(-spread, spread);
 }
 
-Material cardboard(Rng& rng) {
-  Material m;
-  m.albedo = V3(0.35f, 0.52f, 0.68f) * rng.uniform(0.8f, 1.15f);
-  m.texture = Texture::kPlain;
-  m.contrast = 0.15f;
-  m.texel_m = 0.01f;
-  return m;
-}
 
 // Bookcases and open shelving: 0.6-1.2 m wide, 0.25-0.45 m deep, 0.8-2.0 m high, boards every
 // 25-40 cm (a book's height and a hand), books on some; one in four a ladder shelf whose boards
@@ -697,6 +843,9 @@ const std::vector<PresetDef>& world2_defs() {
           "low-riser flights up or down: risers 8-12 cm, goings 30-60 cm, any 2R+T (training stairs, garden steps)",
           low_static),
       def("world2_steep_static", "steep flights up or down: goings 20-24 cm, risers 18-25 cm, narrow", steep_static),
+      def("world2_dressed_static",
+          "carpeted flights (bull-nosed, pile relief) and shoes, bags and boxes (10-40 cm) on 1-3 treads, up or down",
+          dressed_static),
       def("world2_legs_static",
           "the wearer's own legs and feet at the bottom of a steep view (tilt 50-80 deg) before a flight up or down",
           legs_static),
