@@ -48,6 +48,8 @@ const std::vector<PresetDef>& world_preset_defs();
 const std::vector<PresetDef>& walk_defs();
 /// Views from any chest or waist rig (synthetic.hpp: rig_presets()).
 const std::vector<PresetDef>& rig_defs();
+/// The second world (synthetic.hpp: world2_presets()), in synthetic_world2.cpp.
+const std::vector<PresetDef>& world2_defs();
 // nullptr when unknown.
 const PresetDef* find_preset(const std::string& name);
 std::uint64_t name_hash(const std::string& s);

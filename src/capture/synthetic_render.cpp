@@ -42,12 +42,25 @@ struct FaceShade {
   const float* tex;
   float contrast;
   float col[3];  // 255 * Lambert * albedo (BGR)
+  float relief = 0.f;  // m, Material::relief_m
 };
 
 // floor() without the libm call (baseline x86-64 has no SSE4.1 round instruction).
 inline int fast_floor(float x) {
   const int i = static_cast<int>(x);
   return x < static_cast<float>(i) ? i - 1 : i;
+}
+
+// The face's texture, bilinear, at texture coordinates (ts, tt) in texels.
+inline float texture_at(const FaceShade& s, float ts, float tt) {
+  constexpr int TN = detail::kTextureSize;
+  const int is = fast_floor(ts), it = fast_floor(tt);
+  const float ax = ts - static_cast<float>(is), ay = tt - static_cast<float>(it);
+  const int x0 = is & (TN - 1), y0 = it & (TN - 1);
+  const int x1 = (x0 + 1) & (TN - 1), y1 = (y0 + 1) & (TN - 1);
+  const float a = s.tex[y0 * TN + x0], b = s.tex[y0 * TN + x1], c = s.tex[y1 * TN + x0], d = s.tex[y1 * TN + x1];
+  const float top = a + (b - a) * ax, bot = c + (d - c) * ax;
+  return top + (bot - top) * ay;
 }
 
 }  // namespace
@@ -191,6 +204,7 @@ void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsi
     s.tb = inv_texel * (t_wc - f.tex_origin).dot(f.tex_t);
     s.tex = detail::texture(mat.texture);
     s.contrast = mat.contrast;
+    s.relief = mat.relief_m;
     const float lambert = scene.ambient + (1.f - scene.ambient) * std::max(0.f, f.normal.dot(light));
     for (int c = 0; c < 3; ++c) s.col[c] = 255.f * lambert * mat.albedo[c];
   }
@@ -217,10 +231,16 @@ void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsi
         if (col) col[3 * u] = col[3 * u + 1] = col[3 * u + 2] = 40;
         continue;
       }
-      const float z = 1.f / zrow[u];
-      zrow[u] = z;
+      float z = 1.f / zrow[u];
       const FaceShade& s = fs[static_cast<std::size_t>(fi)];
       const float fu = static_cast<float>(u);
+      if (s.relief > 0.f) {
+        // A surface with a relief (carpet pile): the depth follows its texture, a few mm either way.
+        const float ts = z * (s.su * fu + s.sv * fv + s.s0) + s.sb;
+        const float tt = z * (s.tu * fu + s.tv * fv + s.t0) + s.tb;
+        z += s.relief * texture_at(s, ts, tt);
+      }
+      zrow[u] = z;
       crow[u] = std::abs(s.nu * fu + s.nv * fv + s.n0) * ray_norm_inv[static_cast<std::size_t>(u)];
       if (!col) continue;
       float k = 1.f;

@@ -39,6 +39,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
     for (const auto& p : detail::world_preset_defs()) known += ", " + p.info.name;
     for (const auto& p : detail::walk_defs()) known += ", " + p.info.name;
     for (const auto& p : detail::rig_defs()) known += ", " + p.info.name;
+    for (const auto& p : detail::world2_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -147,8 +148,13 @@ const std::vector<PresetInfo>& rig_presets() {
   return list;
 }
 
+const std::vector<PresetInfo>& world2_presets() {
+  static const std::vector<PresetInfo> list = infos(detail::world2_defs());
+  return list;
+}
+
 const PresetInfo* find_preset_info(const std::string& name) {
-  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets()})
+  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets()})
     for (const auto& p : *l)
       if (p.name == name) return &p;
   return nullptr;

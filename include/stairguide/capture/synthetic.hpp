@@ -44,6 +44,14 @@ const std::vector<PresetInfo>& walk_presets();
 /// empty room or before a table, bed, bench or raised landing 0.4-0.8 m below it. Kept out of
 /// presets() so the suites that run every preset keep their figures.
 const std::vector<PresetInfo>& rig_presets();
+/// The second world (issue 39): what real stairs have and the first world lacked, and stair-free
+/// furniture a looser decision could take for stairs. Static views, one drawn per frame: L- and
+/// U-shaped stairs seen from their landing, low-riser and steep flights, carpeted and cluttered
+/// flights, the wearer's own legs in view, low (waist or hip) rigs, and shelves, stacked boxes, a
+/// sofa, a bench, a low table and a bed. Every parameter is drawn from the real world's range
+/// (docs/synthetic.md), never from what the detector accepts. Kept out of presets() and
+/// world_presets() so the suites that run those keep their figures.
+const std::vector<PresetInfo>& world2_presets();
 /// A preset or walk by name; nullptr when there is none.
 const PresetInfo* find_preset_info(const std::string& name);
 

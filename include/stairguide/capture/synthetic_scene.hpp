@@ -23,6 +23,10 @@ struct Material {
   Texture texture = Texture::kPlain;
   float contrast = 0.3f;   ///< texture modulation amplitude (0 = flat colour)
   float texel_m = 0.005f;  ///< m, size of one texel on the surface
+  /// m, depth relief following the texture (a carpet's pile: the rendered depth moves by
+  /// relief_m times the texture's unit-variance value); 0 = a flat face, as every face but the
+  /// second world's carpets.
+  float relief_m = 0.f;
 };
 
 /// A planar convex face of a solid, in world coordinates.
