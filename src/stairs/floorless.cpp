@@ -523,7 +523,13 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
     // camera held level (a hand-held or tripod view, no wearer) keeps the old refusal: its model
     // of a floor strip and open treads came out inconsistent (treads of -39 to 70 cm).
     const bool rig_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
-    if (rig_view) return;
+    // Modelled on the first level as the floor, the origin lies on a true edge whichever it is:
+    // the level's far side is riser 1 if it is the floor, riser 2 if it is the first tread. The
+    // count is what stays unknown.
+    if (rig_view && model_on_floor_level(scene, K, dir, out)) {
+      out.without_floor = true;
+      return;
+    }
     out.detected = false;
     out.verdict = StairVerdict::kNoFirstStep;
     return;
