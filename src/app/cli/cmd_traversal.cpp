@@ -1,13 +1,17 @@
 // Traversal commands (issue 32):
 //   stairguide replay INPUT --out DIR [--frames N] [--drift SCALE_PERCENT,YAW_DEG_PER_S]
 //   stairguide eval-traversal DIR... [--json]
-// replay runs the daemon's stages in order on one thread, as fast as they go (our DenseOdometry,
-// perception, the stairs stage and the traversal tracker, plus a second tracker held by the
-// odometry alone for comparison) and writes frames.jsonl (a line per frame), trajectory.txt (TUM)
+// replay runs the daemon's runtime in synchronous mode, as fast as it goes (our DenseOdometry,
+// perception with the Manhattan carry, the stairs stage, the traversal tracker and the cue
+// decision, exactly as the daemon composes them, plus a second tracker held by the odometry alone
+// for comparison) and writes frames.jsonl (a line per frame), trajectory.txt (TUM)
 // and traversal.png (the camera's y_S-z_S path against the stair profile with and without the
 // correction, the paper's Fig. 19, and the gap at each step, Fig. 20). eval-traversal scores
 // those folders against the truth the input carried (synthetic walks, labelled datasets).
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -24,17 +28,14 @@
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/core/json.hpp"
-#include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/runtime/logging.hpp"
+#include "stairguide/runtime/runtime.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "stairguide/stairs/traversal.hpp"
 
 namespace stairguide::cli {
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // "2,1" -> 2 % scale error, 1 deg/s yaw.
 void parse_drift(const std::string& s, float& scale, float& yaw_rate) {
@@ -128,79 +129,172 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
   if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write the PNG");
 }
 
+// An output file whose every failure is named. Each frame's line is flushed as it is written, so a
+// failed write (a full disk) names the very frame, and the file is cut back to its last whole line:
+// what it holds is then every frame before that one, never half a line.
+class OutFile {
+ public:
+  explicit OutFile(std::string path) : path_(std::move(path)), f_(std::fopen(path_.c_str(), "w")) {
+    if (!f_) throw std::runtime_error(path_ + ": cannot create (" + std::strerror(errno) + ")");
+  }
+  ~OutFile() {
+    if (f_) std::fclose(f_);
+  }
+  OutFile(const OutFile&) = delete;
+  OutFile& operator=(const OutFile&) = delete;
+  const std::string& path() const { return path_; }
+
+  /// Writes `text` (whole lines); `what` names them in the error ("frame 12").
+  void write(const std::string& text, const std::string& what) {
+    if (std::fwrite(text.data(), 1, text.size(), f_) != text.size() || std::fflush(f_) != 0) {
+      const int e = errno;
+      if (ftruncate(fileno(f_), whole_) == 0) std::fseek(f_, whole_, SEEK_SET);
+      throw std::runtime_error(path_ + ": cannot write " + what + " (" + std::strerror(e) + ")");
+    }
+    whole_ += static_cast<off_t>(text.size());
+  }
+  /// Flushes to the disk and closes: a failure here is a failure of the whole file.
+  void close() {
+    std::FILE* f = f_;
+    f_ = nullptr;
+    const bool synced = std::fflush(f) == 0 && (fsync(fileno(f)) == 0 || errno == EINVAL || errno == EROFS);
+    const int e = errno;
+    if (std::fclose(f) != 0 || !synced)
+      throw std::runtime_error(path_ + ": cannot write the file to the disk (" + std::strerror(synced ? errno : e) +
+                               ")");
+  }
+
+ private:
+  std::string path_;
+  std::FILE* f_ = nullptr;
+  off_t whole_ = 0;  // bytes of whole lines written
+};
+
+// `--drift`: every increment of the odometry (1 + scale) long, the world turning yaw_rate * t about
+// the vertical (the first floor's, in the odometry's world). Applied to the odometry's output
+// before any stage uses it, so the tracker, the Manhattan carry and the held tracker all see it.
+struct Drift {
+  float scale = 0.f, yaw_rate = 0.f;
+  Pose drifted = Pose::Identity(), last_raw = Pose::Identity(), raw = Pose::Identity();
+  Eigen::Vector3f up_world{0.f, -1.f, 0.f};
+  bool have_up = false, have_raw = false;
+
+  bool on() const { return scale != 0.f || yaw_rate != 0.f; }
+  void apply(double timestamp, Pose& T_wc) {
+    raw = T_wc;
+    if (!on()) return;
+    const Eigen::Matrix3f Rz =
+        Eigen::AngleAxisf(yaw_rate * static_cast<float>(timestamp), up_world).toRotationMatrix();
+    const Eigen::Vector3f p =
+        have_raw ? Eigen::Vector3f(drifted.translation() +
+                                   Rz * ((1.f + scale) * (T_wc.translation() - last_raw.translation())))
+                 : T_wc.translation();
+    last_raw = T_wc;
+    have_raw = true;
+    drifted.linear() = Rz * T_wc.linear();
+    drifted.translation() = p;
+    T_wc = drifted;
+  }
+  // The vertical from the first floor seen, in the odometry's own (undrifted) world.
+  void see_floor(const SceneResult& scene) {
+    if (have_up || !scene.floor_found) return;
+    up_world = (raw.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY()).normalized();
+    have_up = true;
+  }
+};
+
+// One frame's line of frames.jsonl.
+std::string frame_line(long n, const runtime::FrameObservation& ob, const TraversalResult& u, const Sample& sm,
+                       const StairTruth* st, float t_along) {
+  const runtime::OdometryOutput& o = ob.odometry;
+  const runtime::PerceptionOutput& p = ob.perception;
+  const TraversalResult& r = p.traversal;
+  const StairResult& stair = ob.stair;
+  auto num = [](double v) { return json_number(v); };
+  std::string line =
+      "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(ob.frame.timestamp) +
+      ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) + ", \"perception\": " + json_quote(p.state) +
+      ", \"manhattan\": " +
+      json_quote(!p.manhattan_found ? "none" : p.manhattan_carried ? "carried" : "seen") +
+      ", \"detected\": " + std::to_string(stair.detected ? 1 : 0) +
+      ", \"kind\": " + json_quote(to_string(stair.kind)) + ", \"levels\": " + std::to_string(stair.levels) +
+      ", \"det_riser_m\": " + num(stair.riser_m) + ", \"det_tread_m\": " + num(stair.tread_m) +
+      ", \"state\": " + json_quote(r.ran ? to_string(r.state) : "-") + ", \"step\": " + std::to_string(r.step_index) +
+      ", \"left\": " + std::to_string(r.steps_left) + ", \"known\": " + std::to_string(r.steps_known) +
+      ", \"last_known\": " + std::to_string(r.last_known ? 1 : 0) +
+      ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) + ", \"distance_m\": " + num(r.distance_m) +
+      ", \"riser_m\": " + num(r.riser_m) + ", \"tread_m\": " + num(r.tread_m) +
+      ", \"width_m\": " + num(r.width_m) + ", \"corr_height_m\": " + num(r.corr_height_m) +
+      ", \"corr_along_m\": " + num(r.corr_along_m) + ", \"corr_yaw_rad\": " + num(r.corr_yaw_rad) +
+      ", \"has_model\": " + std::to_string(r.direction != 0 ? 1 : 0) + ", \"cam_y\": " + num(sm.cam_y) +
+      ", \"cam_z\": " + num(sm.cam_z) + ", \"cue\": " + json_quote(ob.cue.empty() ? "-" : ob.cue) +
+      ", \"u_state\": " + json_quote(to_string(u.state)) + ", \"u_step\": " + std::to_string(u.step_index) +
+      ", \"u_has_model\": " + std::to_string(u.direction != 0 ? 1 : 0) + ", \"u_cam_y\": " + num(sm.u_cam_y) +
+      ", \"u_cam_z\": " + num(sm.u_cam_z);
+  if (st)
+    line += ", \"truth\": 1, \"t_step\": " + std::to_string(st->user_step) +
+            ", \"t_steps\": " + std::to_string(st->steps) +
+            ", \"t_direction\": " + std::to_string(st->goes_down() ? -1 : 1) +
+            ", \"t_riser_m\": " + num(st->riser_m) + ", \"t_tread_m\": " + num(st->tread_m) +
+            ", \"t_along\": " + num(t_along) + ", \"t_cam_y\": " + num(sm.t_cam_y) +
+            ", \"t_cam_z\": " + num(sm.t_cam_z);
+  else
+    line += ", \"truth\": 0";
+  line += ", \"ms_odometry\": " + num(o.ms) + ", \"ms_perception\": " + num(p.ms) +
+          ", \"ms_traversal\": " + num(r.ms) + "}\n";
+  return line;
+}
+
+// The daemon's runtime in synchronous mode (runtime.hpp: every frame through odometry, perception
+// with the Manhattan carry, stairs, traversal and the cue decision, in order, on this thread): the
+// replay's figures are the daemon's by construction. This command only adds what it writes: the
+// files, and a second tracker held by the odometry alone, fed what the runtime's stages saw.
 int replay(Context& ctx) {
   const auto out = ctx.option("--out");
   const auto max_frames = ctx.int_option("--frames", 1, 100000000);
-  float drift_scale = 0.f, drift_yaw = 0.f;
-  if (const auto d = ctx.option("--drift")) parse_drift(*d, drift_scale, drift_yaw);
+  Drift drift;
+  if (const auto d = ctx.option("--drift")) parse_drift(*d, drift.scale, drift.yaw_rate);
   const auto pos = ctx.positionals(1, 1);
   if (!out) throw UsageError("--out DIR is required");
   std::error_code ec;
   std::filesystem::create_directories(*out, ec);
   if (ec) throw std::runtime_error(*out + ": cannot create the folder (" + ec.message() + ")");
-  auto src = open_frame_source(pos[0], ctx.config.capture);
-  std::ofstream jl(*out + "/frames.jsonl"), traj(*out + "/trajectory.txt");
-  if (!jl || !traj) throw std::runtime_error(*out + ": cannot write frames.jsonl / trajectory.txt");
-  traj << "# timestamp tx ty tz qx qy qz qw (stairguide replay: DenseOdometry"
-       << (drift_scale != 0 || drift_yaw != 0 ? ", drift injected" : "") << ")\n";
+  OutFile jl(*out + "/frames.jsonl"), traj(*out + "/trajectory.txt");
+  traj.write(std::string("# timestamp tx ty tz qx qy qz qw (stairguide replay: DenseOdometry") +
+                 (drift.on() ? ", drift injected" : "") + ")\n",
+             "the header");
 
-  DenseOdometry odo;
-  odo.configure(ctx.config.odometry, src->intrinsics());
-  Perception perception(ctx.config);
-  StairStage stage(ctx.config);
-  TraversalTracker tracker(ctx.config.traversal);
-  TraversalConfig held_cfg = ctx.config.traversal;
+  // The cues are decided (frames.jsonl has them) but never played.
+  PipelineConfig config = ctx.config;
+  config.feedback.audio_enabled = false;
+  config.feedback.haptic_enabled = false;
+  TraversalConfig held_cfg = config.traversal;
   held_cfg.correct = false;
   TraversalTracker held(held_cfg);
-  RgbdFrame f;
-  SceneResult scene;
-  StairResult stair;
+
   std::vector<Sample> samples;
   TraversalResult last_model;
   int steps = 0, direction = 1;
   float riser = 0.f, tread = 0.f;
   std::uint64_t track = 0;
-  Pose drifted = Pose::Identity(), last_raw = Pose::Identity();
-  Eigen::Vector3f up_world(0.f, -1.f, 0.f);
-  bool have_up = false, have_raw = false;
   const bool tty = isatty(STDERR_FILENO);
-  const long total = src->frame_count();
-  long n = 0;
-  while ((!max_frames || n < *max_frames) && src->read(f).ok()) {
-    auto t0 = std::chrono::steady_clock::now();
-    const OdometryResult o = odo.track(f);
-    const double ms_odo = ms_since(t0);
+  long n = 0, total = -1;
+
+  runtime::RuntimeOptions opt;
+  opt.input = pos[0];
+  opt.realtime = false;
+  opt.synchronous = true;
+  opt.frame_lines = false;
+  opt.max_frames = max_frames ? *max_frames : -1;
+  if (drift.on())
+    opt.pose_filter = [&](const RgbdFrame& f, runtime::OdometryOutput& o) { drift.apply(f.timestamp, o.T_world_camera); };
+  opt.observer = [&](const runtime::FrameObservation& ob) {
+    const runtime::OdometryOutput& o = ob.odometry;
+    const TraversalResult& r = ob.perception.traversal;
+    const Pose& T_wc = o.T_world_camera;
+    if (drift.on()) drift.see_floor(ob.scene);
     if (!o.ok) ++track;
-    Pose T_wc = o.T_world_camera;
-    t0 = std::chrono::steady_clock::now();
-    perception.process(f, scene);
-    const double ms_perc = ms_since(t0);
-    if (!have_up && scene.floor_found) {
-      up_world =
-          (o.T_world_camera.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY())
-              .normalized();
-      have_up = true;
-    }
-    if (drift_scale != 0.f || drift_yaw != 0.f) {
-      // Every increment (1 + scale) long, the world turning yaw_rate * t about the vertical.
-      const Eigen::Matrix3f Rz =
-          Eigen::AngleAxisf(drift_yaw * static_cast<float>(f.timestamp), up_world).toRotationMatrix();
-      const Eigen::Vector3f p =
-          have_raw
-              ? Eigen::Vector3f(drifted.translation() +
-                                Rz * ((1.f + drift_scale) * (T_wc.translation() - last_raw.translation())))
-              : T_wc.translation();
-      last_raw = T_wc;
-      have_raw = true;
-      drifted.linear() = Rz * T_wc.linear();
-      drifted.translation() = p;
-      T_wc = drifted;
-    }
-    t0 = std::chrono::steady_clock::now();
-    stage.run(scene, f.intrinsics, stair);
-    const double ms_stairs = ms_since(t0);
-    const TraversalResult r = tracker.update(scene, stair, T_wc, o.ok, f.timestamp, track);
-    const TraversalResult u = held.update(scene, stair, T_wc, o.ok, f.timestamp, track);
+    const TraversalResult u = held.update(ob.scene, ob.stair, T_wc, o.ok, ob.frame.timestamp, track);
     if (r.direction != 0) last_model = r;
     Sample sm;
     if (r.direction != 0) {
@@ -211,67 +305,50 @@ int replay(Context& ctx) {
       const Eigen::Vector3f c = u.T_world_stair.inverse() * T_wc.translation();
       sm.u_cam_y = c.y(), sm.u_cam_z = c.z();
     }
-    const auto truth = src->truth();
+    const auto truth = ob.source.truth();
     const StairTruth* st = truth && !truth->stairs.empty() ? &truth->stairs[0] : nullptr;
     float t_along = NAN;
     if (st) {
       const Pose T_sc = st->T_camera_stair.inverse();
       Eigen::Vector3f fwd = T_sc.linear().col(2);
       fwd.y() = 0.f;
-      t_along = (T_sc.translation() - ctx.config.traversal.body_behind * fwd.normalized()).z();
+      t_along = (T_sc.translation() - config.traversal.body_behind * fwd.normalized()).z();
       sm.t_cam_y = T_sc.translation().y(), sm.t_cam_z = T_sc.translation().z();
       sm.t_step = st->user_step;
       steps = st->steps, riser = st->riser_m, tread = st->tread_m, direction = st->goes_down() ? -1 : 1;
     }
     samples.push_back(sm);
+    const std::string what = "frame " + std::to_string(n);
+    jl.write(frame_line(n, ob, u, sm, st, t_along), what);
     const Eigen::Quaternionf q(T_wc.linear());
     char tl[200];
-    std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", f.timestamp,
-                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(),
-                  q.w());
-    traj << tl;
-    auto num = [](double v) { return json_number(v); };
-    std::string line =
-        "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(f.timestamp) +
-        ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) +
-        ", \"detected\": " + std::to_string(stair.detected ? 1 : 0) +
-        ", \"kind\": " + json_quote(to_string(stair.kind)) + ", \"levels\": " + std::to_string(stair.levels) +
-        ", \"det_riser_m\": " + num(stair.riser_m) + ", \"det_tread_m\": " + num(stair.tread_m) +
-        ", \"state\": " + json_quote(to_string(r.state)) + ", \"step\": " + std::to_string(r.step_index) +
-        ", \"left\": " + std::to_string(r.steps_left) + ", \"known\": " + std::to_string(r.steps_known) +
-        ", \"last_known\": " + std::to_string(r.last_known ? 1 : 0) +
-        ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) + ", \"distance_m\": " + num(r.distance_m) +
-        ", \"riser_m\": " + num(r.riser_m) + ", \"tread_m\": " + num(r.tread_m) +
-        ", \"width_m\": " + num(r.width_m) + ", \"corr_height_m\": " + num(r.corr_height_m) +
-        ", \"corr_along_m\": " + num(r.corr_along_m) + ", \"corr_yaw_rad\": " + num(r.corr_yaw_rad) +
-        ", \"has_model\": " + std::to_string(r.direction != 0 ? 1 : 0) + ", \"cam_y\": " + num(sm.cam_y) +
-        ", \"cam_z\": " + num(sm.cam_z) + ", \"u_state\": " + json_quote(to_string(u.state)) +
-        ", \"u_step\": " + std::to_string(u.step_index) +
-        ", \"u_has_model\": " + std::to_string(u.direction != 0 ? 1 : 0) +
-        ", \"u_cam_y\": " + num(sm.u_cam_y) + ", \"u_cam_z\": " + num(sm.u_cam_z);
-    if (st)
-      line += ", \"truth\": 1, \"t_step\": " + std::to_string(st->user_step) +
-              ", \"t_steps\": " + std::to_string(st->steps) +
-              ", \"t_direction\": " + std::to_string(st->goes_down() ? -1 : 1) +
-              ", \"t_riser_m\": " + num(st->riser_m) + ", \"t_tread_m\": " + num(st->tread_m) +
-              ", \"t_along\": " + num(t_along) + ", \"t_cam_y\": " + num(sm.t_cam_y) +
-              ", \"t_cam_z\": " + num(sm.t_cam_z);
-    else
-      line += ", \"truth\": 0";
-    line += ", \"ms_odometry\": " + num(ms_odo) + ", \"ms_perception\": " + num(ms_perc) +
-            ", \"ms_stairs\": " + num(ms_stairs) + ", \"ms_traversal\": " + num(r.ms) + "}\n";
-    jl << line;
+    std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", ob.frame.timestamp,
+                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(), q.w());
+    traj.write(tl, what);
     ++n;
+    if (total < 0) total = ob.source.frame_count();
     if (tty && n % 10 == 0) {
       if (total > 0)
         std::fprintf(stderr, "\rreplay: frame %ld of %ld", n, total);
       else
         std::fprintf(stderr, "\rreplay: frame %ld", n);
     }
+  };
+  runtime::setup_logging("warn");  // the runtime's start and end lines would otherwise go to stdout
+  runtime::Runtime rt(config, opt, nullptr);
+  rt.start();  // a missing or corrupt input throws, naming it
+  const int code = rt.run();
+  if (tty && n >= 10) std::fprintf(stderr, "\n");
+  // What was read is kept (the files hold every frame before a failure), then the failure is named.
+  jl.close();
+  traj.close();
+  if (n > 0) draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
+  if (code != 0) {
+    const std::string why = rt.failure().empty() ? pos[0] + ": the replay failed" : rt.failure();
+    throw std::runtime_error(why + "; " + *out + "/frames.jsonl and trajectory.txt hold the " + std::to_string(n) +
+                             " frames before it");
   }
-  if (tty) std::fprintf(stderr, "\n");
   if (n == 0) throw std::runtime_error(pos[0] + ": no frame could be read");
-  draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
   std::printf("replay: %ld frames -> %s/frames.jsonl, trajectory.txt, traversal.png\n", n, out->c_str());
   return 0;
 }
@@ -416,7 +493,8 @@ int eval_traversal(Context& ctx) {
 }  // namespace
 
 SG_COMMAND("replay", "replay INPUT --out DIR [--frames N] [--drift SCALE_PERCENT,YAW_DEG_PER_S]",
-           "odometry, perception, stairs and traversal in order; frames.jsonl, trajectory.txt, traversal.png",
+           "the daemon's pipeline on one thread (as stairguided --sync); frames.jsonl, trajectory.txt, "
+           "traversal.png",
            replay);
 SG_COMMAND("eval-traversal", "eval-traversal DIR... [--json]",
            "scores replay folders: step index, count, phantom and last steps, drift gap, fused vs "
