@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -58,10 +59,97 @@ struct Sample {
   int t_step = -1;
 };
 
+// ---- traversal.png: two plots with axes in metres (and centimetres), ticks, legends, a title ----
+
+// A tick step of 1, 2 or 5 times a power of ten giving about `n` ticks over `range`.
+double tick_step(double range, int n) {
+  const double raw = std::max(1e-6, range / std::max(1, n));
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 5.0})
+    if (m * p >= raw) return m * p;
+  return 10.0 * p;
+}
+
+void text(cv::Mat& img, const std::string& s, cv::Point at, double scale = 0.45, int thick = 1) {
+  cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), thick, cv::LINE_AA);
+}
+int text_width(const std::string& s, double scale = 0.45) {
+  int base = 0;
+  return cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &base).width;
+}
+std::string tick_label(double v, double step) {
+  char b[32];
+  std::snprintf(b, sizeof b, step < 0.1 ? "%.2f" : step < 1 ? "%.1f" : "%.0f", std::fabs(v) < 1e-9 ? 0.0 : v);
+  return b;
+}
+
+// A plot area `box` showing x in [x0, x1] and y in [y0, y1] (data units): frame, ticks and labels.
+struct Axes {
+  cv::Rect box;
+  double x0, x1, y0, y1;
+  cv::Point at(double x, double y) const {
+    return cv::Point(box.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * box.width)),
+                     box.y + box.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * box.height)));
+  }
+  void draw(cv::Mat& img, const std::string& xlabel, const std::string& ylabel, double xscale = 1.0,
+            double yscale = 1.0) const {
+    const cv::Scalar grid(225, 225, 225), black(0, 0, 0);
+    const double xs = tick_step((x1 - x0) * xscale, 8), ys = tick_step((y1 - y0) * yscale, 6);
+    for (double v = std::ceil(x0 * xscale / xs) * xs; v <= x1 * xscale + 1e-9; v += xs) {
+      const cv::Point p = at(v / xscale, y0);
+      cv::line(img, cv::Point(p.x, box.y), cv::Point(p.x, box.y + box.height), grid, 1);
+      cv::line(img, p, p + cv::Point(0, 5), black, 1);
+      const std::string l = tick_label(v, xs);
+      text(img, l, p + cv::Point(-text_width(l) / 2, 20));
+    }
+    for (double v = std::ceil(y0 * yscale / ys) * ys; v <= y1 * yscale + 1e-9; v += ys) {
+      const cv::Point p = at(x0, v / yscale);
+      cv::line(img, cv::Point(box.x, p.y), cv::Point(box.x + box.width, p.y), grid, 1);
+      cv::line(img, p, p - cv::Point(5, 0), black, 1);
+      const std::string l = tick_label(v, ys);
+      text(img, l, p + cv::Point(-9 - text_width(l), 5));
+    }
+    cv::rectangle(img, box, black, 1);
+    text(img, xlabel, cv::Point(box.x + box.width / 2 - text_width(xlabel) / 2, box.y + box.height + 40));
+    // The y label, written upright to the left of the tick labels.
+    const int w = text_width(ylabel), h = 20;
+    cv::Mat label(h, w + 4, CV_8UC3, cv::Scalar(255, 255, 255));
+    text(label, ylabel, cv::Point(2, 14));
+    cv::Mat up;
+    cv::rotate(label, up, cv::ROTATE_90_COUNTERCLOCKWISE);
+    const int lx = std::max(0, box.x - 62), ly = std::max(0, box.y + box.height / 2 - up.rows / 2);
+    if (lx + up.cols <= img.cols && ly + up.rows <= img.rows) up.copyTo(img(cv::Rect(lx, ly, up.cols, up.rows)));
+  }
+};
+
+// A legend box at `corner` (top-left): a sample of each colour and its meaning.
+void legend(cv::Mat& img, cv::Point corner, const std::vector<std::pair<cv::Scalar, std::string>>& items,
+            bool bars = false) {
+  int w = 0;
+  for (const auto& it : items) w = std::max(w, text_width(it.second));
+  const cv::Rect box(corner.x, corner.y, w + 50, 20 * static_cast<int>(items.size()) + 8);
+  cv::rectangle(img, box, cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::rectangle(img, box, cv::Scalar(0, 0, 0), 1);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const int y = corner.y + 16 + 20 * static_cast<int>(i);
+    if (bars)
+      cv::rectangle(img, cv::Point(corner.x + 8, y - 9), cv::Point(corner.x + 34, y + 1), items[i].first, cv::FILLED);
+    else
+      cv::line(img, cv::Point(corner.x + 8, y - 4), cv::Point(corner.x + 34, y - 4), items[i].first, 2);
+    text(img, items[i].second, cv::Point(corner.x + 42, y));
+  }
+}
+
 void draw_png(const std::string& path, const std::vector<Sample>& s, const TraversalResult& model, int steps,
               float riser, float tread, int direction) {
-  const int W = 900, H = 700, plot_h = 460;
+  const int W = 1000, H = 860;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Scalar truth_c(200, 120, 0), odo_c(0, 0, 220), corr_c(0, 160, 0), stair_c(0, 0, 0);
+  text(img, "stairguide replay: the camera in the stair frame, corrected and by odometry alone", cv::Point(20, 28),
+       0.6, 2);
+
+  // Top: the camera's y_S-z_S path against the stair profile (the paper's Fig. 19), one metre the
+  // same length on both axes.
   float zmin = -1.f, zmax = 1.f, ymin = -0.5f, ymax = 2.f;
   for (const Sample& p : s)
     for (const auto& q : {std::make_pair(p.cam_z, p.cam_y), std::make_pair(p.u_cam_z, p.u_cam_y),
@@ -73,59 +161,70 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
   const int n = std::max(steps, model.steps_known);
   const float r = riser > 0 ? riser : model.riser_m, t = tread > 0 ? tread : model.tread_m;
   ymin = std::min(ymin, direction < 0 ? -r * static_cast<float>(n) - 0.1f : -r - 0.1f);
-  const float sx = static_cast<float>(W - 80) / std::max(0.1f, zmax - zmin);
-  const float sy = static_cast<float>(plot_h - 60) / std::max(0.1f, ymax - ymin);
-  const float sc = std::min(sx, sy);
-  auto P = [&](float z, float y) {
-    return cv::Point(40 + static_cast<int>((z - zmin) * sc), plot_h - 30 - static_cast<int>((y - ymin) * sc));
-  };
-  // The stair profile (stair frame: ascending tread j at y = (j-1) r from z = (j-1) t).
-  std::vector<cv::Point> prof;
+  zmin -= 0.1f, zmax += 0.1f, ymin -= 0.05f, ymax += 0.1f;
+  const cv::Rect area(90, 60, W - 120, 420);
+  const double sc = std::min(area.width / std::max(0.1f, zmax - zmin), area.height / std::max(0.1f, ymax - ymin));
+  const int pw = static_cast<int>(sc * (zmax - zmin)), ph = static_cast<int>(sc * (ymax - ymin));
+  Axes top{cv::Rect(area.x, area.y + area.height - ph, pw, ph), zmin, zmax, ymin, ymax};
+  top.draw(img, "z_S: along the stair from its first edge (m)", "y_S: up (m)");
   if (n > 0 && r > 0 && t > 0) {
+    // Stair frame: ascending tread j at y = (j-1) r from z = (j-1) t; descending tread j at -j r.
+    std::vector<cv::Point> prof;
     float y = direction > 0 ? -r : 0.f;
-    prof.push_back(P(zmin, y));
+    prof.push_back(top.at(zmin, y));
     for (int j = 1; j <= n; ++j) {
-      const float z = direction > 0 ? static_cast<float>(j - 1) * t : static_cast<float>(j - 1) * t;
-      prof.push_back(P(z, y));
+      const float z = static_cast<float>(j - 1) * t;
+      prof.push_back(top.at(z, y));
       y = direction > 0 ? static_cast<float>(j - 1) * r : -static_cast<float>(j) * r;
-      prof.push_back(P(z, y));
+      prof.push_back(top.at(z, y));
     }
-    prof.push_back(P(zmax, y));
-    cv::polylines(img, prof, false, cv::Scalar(0, 0, 0), 2);
+    prof.push_back(top.at(zmax, y));
+    cv::polylines(img, prof, false, stair_c, 2, cv::LINE_AA);
   }
   auto path_of = [&](auto get, const cv::Scalar& col) {
     std::vector<cv::Point> pts;
     for (const Sample& p : s) {
       const auto [z, y] = get(p);
-      if (std::isfinite(z) && std::isfinite(y)) pts.push_back(P(z, y));
+      if (std::isfinite(z) && std::isfinite(y)) pts.push_back(top.at(z, y));
     }
-    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2);
+    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2, cv::LINE_AA);
   };
-  path_of([](const Sample& p) { return std::make_pair(p.t_cam_z, p.t_cam_y); }, cv::Scalar(200, 120, 0));
-  path_of([](const Sample& p) { return std::make_pair(p.u_cam_z, p.u_cam_y); }, cv::Scalar(0, 0, 220));
-  path_of([](const Sample& p) { return std::make_pair(p.cam_z, p.cam_y); }, cv::Scalar(0, 160, 0));
-  cv::putText(img, "camera y_S-z_S: green corrected, red odometry only, blue truth, black stair profile",
-              cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
-  // The gap in z_S the moment each step is reached (needs the truth).
-  const int base = H - 30, top = plot_h + 30;
-  cv::line(img, cv::Point(40, base), cv::Point(W - 20, base), cv::Scalar(0, 0, 0), 1);
-  cv::putText(img, "gap along z_S at each step (cm, 0-20): green corrected, red odometry only",
-              cv::Point(10, plot_h + 15), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  path_of([](const Sample& p) { return std::make_pair(p.t_cam_z, p.t_cam_y); }, truth_c);
+  path_of([](const Sample& p) { return std::make_pair(p.u_cam_z, p.u_cam_y); }, odo_c);
+  path_of([](const Sample& p) { return std::make_pair(p.cam_z, p.cam_y); }, corr_c);
+  legend(img, cv::Point(top.box.x + 10, top.box.y + 10),
+         {{corr_c, "camera, odometry corrected by the live view (eq. 15)"},
+          {odo_c, "camera, odometry alone (eq. 14)"},
+          {truth_c, "camera, ground truth"},
+          {stair_c, "stair profile"}});
+
+  // Bottom: the gap along z_S to the truth the moment each step is reached (Fig. 20; needs the truth).
+  const int gtop = 570;
+  text(img, "gap along z_S to the truth when each step is reached (the paper's Fig. 20)", cv::Point(20, gtop - 20),
+       0.55, 1);
+  double gmax = 0.05;
   std::vector<bool> done(static_cast<std::size_t>(std::max(steps, 0) + 1), false);
-  const int bw = steps > 0 ? std::max(4, (W - 80) / (2 * steps + 1)) : 10;
+  std::vector<std::array<float, 2>> gaps(static_cast<std::size_t>(std::max(steps, 0) + 1), {NAN, NAN});
   for (const Sample& p : s) {
     if (p.t_step < 1 || p.t_step > steps || done[static_cast<std::size_t>(p.t_step)]) continue;
     done[static_cast<std::size_t>(p.t_step)] = true;
-    const int x = 40 + (2 * p.t_step - 2) * bw;
-    auto bar = [&](float gap, int dx, const cv::Scalar& col) {
-      if (!std::isfinite(gap)) return;
-      const int h = std::min(
-          base - top, static_cast<int>(std::fabs(gap) * 100.f / 20.f * static_cast<float>(base - top)));
-      cv::rectangle(img, cv::Point(x + dx, base - h), cv::Point(x + dx + bw / 2, base), col, cv::FILLED);
-    };
-    bar(p.cam_z - p.t_cam_z, 0, cv::Scalar(0, 160, 0));
-    bar(p.u_cam_z - p.t_cam_z, bw / 2, cv::Scalar(0, 0, 220));
+    gaps[static_cast<std::size_t>(p.t_step)] = {std::fabs(p.cam_z - p.t_cam_z), std::fabs(p.u_cam_z - p.t_cam_z)};
+    for (const float g : gaps[static_cast<std::size_t>(p.t_step)])
+      if (std::isfinite(g)) gmax = std::max(gmax, static_cast<double>(g));
   }
+  Axes bottom{cv::Rect(90, gtop, W - 120, H - gtop - 60), 0.5, std::max(steps, 1) + 0.5, 0.0, gmax * 1.5};
+  bottom.draw(img, steps > 0 ? "step reached" : "step reached (no truth in this input: no gaps)",
+              "gap (cm)", 1.0, 100.0);
+  const double bw = 0.35;
+  for (int k = 1; k <= steps; ++k)
+    for (int i = 0; i < 2; ++i) {
+      const float g = gaps[static_cast<std::size_t>(k)][static_cast<std::size_t>(i)];
+      if (!std::isfinite(g)) continue;
+      const double x = k - bw + i * bw;
+      cv::rectangle(img, bottom.at(x, g), bottom.at(x + bw, 0.0), i == 0 ? corr_c : odo_c, cv::FILLED);
+    }
+  legend(img, cv::Point(bottom.box.x + 10, bottom.box.y + 8),
+         {{corr_c, "corrected by the live view"}, {odo_c, "odometry alone"}}, true);
   if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write the PNG");
 }
 
