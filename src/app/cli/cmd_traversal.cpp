@@ -441,12 +441,17 @@ int replay(Context& ctx) {
   // What was read is kept (the files hold every frame before a failure), then the failure is named.
   jl.close();
   traj.close();
-  if (n > 0) draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
   if (code != 0) {
-    const std::string why = rt.failure().empty() ? pos[0] + ": the replay failed" : rt.failure();
-    throw std::runtime_error(why + "; " + *out + "/frames.jsonl and trajectory.txt hold the " + std::to_string(n) +
-                             " frames before it");
+    std::string why = rt.failure().empty() ? pos[0] + ": the replay failed" : rt.failure();
+    why += "; " + *out + "/frames.jsonl and trajectory.txt hold the " + std::to_string(n) + " frames before it";
+    try {
+      if (n > 0) draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
+    } catch (const std::exception& e) {
+      why += std::string(" (and ") + e.what() + ")";  // the read failure stays the news
+    }
+    throw std::runtime_error(why);
   }
+  if (n > 0) draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
   if (n == 0) throw std::runtime_error(pos[0] + ": no frame could be read");
   std::printf("replay: %ld frames -> %s/frames.jsonl, trajectory.txt, traversal.png\n", n, out->c_str());
   return 0;
