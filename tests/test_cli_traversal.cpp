@@ -155,6 +155,7 @@ TEST(CliTraversal, ATruncatedRecordingIsNamedNotASuccess) {
   const std::string src = tmp("trunc_src"), oni = tmp("trunc.oni"), dir = tmp("trunc");
   std::filesystem::remove_all(src);
   std::filesystem::remove_all(dir);
+  std::filesystem::remove(oni);
   auto r = run("synth --scene climb_3_steps --frames 30 --seed 3 --out " + src + " --oni " + oni);
   ASSERT_EQ(r.code, 0) << r.out;
   std::filesystem::resize_file(oni, std::filesystem::file_size(oni) * 6 / 10);
