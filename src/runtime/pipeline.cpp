@@ -217,6 +217,9 @@ void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, 
   }
 }
 
+const SceneResult& PerceptionStage::last_scene() const { return impl_->scene; }
+const StairResult& PerceptionStage::last_stair() const { return impl_->stair; }
+
 void PerceptionStage::reconfigure(const PipelineConfig& config) {
   // The stages take their config at construction; tracking restarts with the new values. Not the
   // traversal: a reload on the stairs (a SIGHUP for the verbosity) would have started the count

@@ -153,6 +153,7 @@ struct Runtime::Impl {
   bool live = false;
   mutable std::mutex desc_mutex;
   std::string input_desc;
+  std::string failure;  ///< why a replay failed mid-way (desc_mutex)
 
   // ---- stages ----
   std::unique_ptr<OdometryStage> odometry;
@@ -352,7 +353,10 @@ struct Runtime::Impl {
         return NextFrame::kEnd;
       }
       if (!live) {
-        spdlog::error("{}", r.message.empty() ? source->describe() + ": read failed" : r.message);
+        const std::string why = r.message.empty() ? source->describe() + ": read failed" : r.message;
+        spdlog::error("{}", why);
+        std::lock_guard<std::mutex> lk(desc_mutex);
+        failure = source->describe() + ": frame " + std::to_string(next_seq) + " cannot be read: " + why;
         return NextFrame::kError;
       }
       // Live camera stopped sending or vanished: tell the user, close it, reopen with back-off.
@@ -455,6 +459,7 @@ struct Runtime::Impl {
     OdoMsg m;
     m.out = odometry->step(*p.frame);
     m.out.seq = p.seq;
+    if (opt.pose_filter) opt.pose_filter(*p.frame, m.out);
     m.timestamp = p.frame->timestamp;
     m.captured = p.captured;
     odo_frames.fetch_add(1);
@@ -968,6 +973,9 @@ int Runtime::run() {
     PercMsg pm = m.run_perception(p, gen);
     m.on_odometry(om);
     m.on_perception(pm);
+    if (m.opt.observer)
+      m.opt.observer({*p.frame, *m.source, m.odo_pending.back().out, m.perc_pending.back().out,
+                      m.perception->last_scene(), m.perception->last_stair(), m.perc_pending.back().cue});
     m.emit_lines(p.seq + 1, false, false);
     m.handle_camera_events();
     m.beat(kOdometry);
@@ -1047,6 +1055,11 @@ void Runtime::reconfigure(const PipelineConfig& config) {
 RuntimeStats Runtime::stats() const { return impl_->stats(); }
 
 int Runtime::exit_code() const { return impl_->exit_code.load(); }
+
+std::string Runtime::failure() const {
+  std::lock_guard<std::mutex> lk(impl_->desc_mutex);
+  return impl_->failure;
+}
 
 std::string Runtime::describe_input() const {
   std::lock_guard<std::mutex> lk(impl_->desc_mutex);

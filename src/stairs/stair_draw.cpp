@@ -28,6 +28,36 @@ cv::Scalar level_colour(int k) {
   return c[static_cast<std::size_t>(k) % 6];
 }
 
+// A legend of the overlay's colours, bottom left: the levels drawn, the first edge and the axes.
+void draw_legend(cv::Mat& img, int levels) {
+  const int n = std::min(levels, 6);
+  const int rows = 3 + (n > 0 ? 1 : 0), h = 18 * rows + 8, w = 250;
+  const cv::Rect box(6, img.rows - h - 6, w, h);
+  if (box.y < 0 || box.width > img.cols) return;
+  cv::rectangle(img, box, {255, 255, 255}, cv::FILLED);
+  cv::rectangle(img, box, {0, 0, 0}, 1);
+  auto label = [&](int row, const char* s) {
+    cv::putText(img, s, {box.x + 60, box.y + 16 + 18 * row}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {0, 0, 0}, 1, cv::LINE_AA);
+  };
+  int row = 0;
+  if (n > 0) {
+    for (int k = 0; k < n; ++k)
+      cv::rectangle(img, cv::Point(box.x + 6 + 8 * k, box.y + 6), cv::Point(box.x + 12 + 8 * k, box.y + 16),
+                    level_colour(k), cv::FILLED);
+    label(row++, "levels 1, 2, 3 ... (points, boxes)");
+  }
+  const int y1 = box.y + 12 + 18 * row;
+  cv::line(img, {box.x + 6, y1}, {box.x + 50, y1}, {0, 0, 0}, 2);
+  cv::circle(img, {box.x + 50, y1}, 4, {0, 255, 255}, 2, cv::LINE_AA);
+  label(row++, "first edge and its ends");
+  const int y2 = box.y + 12 + 18 * row;
+  cv::line(img, {box.x + 6, y2}, {box.x + 20, y2}, {0, 0, 255}, 2);
+  cv::line(img, {box.x + 21, y2}, {box.x + 35, y2}, {0, 255, 0}, 2);
+  cv::line(img, {box.x + 36, y2}, {box.x + 50, y2}, {255, 0, 0}, 2);
+  label(row++, "stair axes x (edge), y (up), z (in)");
+  label(row++, "colours: red, green, blue");
+}
+
 }  // namespace
 
 void draw_stair_model(cv::Mat& img, const CameraIntrinsics& K, const StairResult& r) {
@@ -89,6 +119,7 @@ void draw_stair_model(cv::Mat& img, const CameraIntrinsics& K, const StairResult
                 to_string(r.method));
   cv::putText(img, caption, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {0, 0, 0}, 3, cv::LINE_AA);
   cv::putText(img, caption, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {255, 255, 255}, 1, cv::LINE_AA);
+  draw_legend(img, r.levels);
 }
 
 }  // namespace stairguide

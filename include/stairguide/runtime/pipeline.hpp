@@ -25,6 +25,8 @@
 
 namespace stairguide {
 struct OdometryLink;  // perception/perception.hpp
+struct SceneResult;   // perception/scene.hpp
+struct StairResult;   // stairs/stair_result.hpp
 }
 
 namespace stairguide::runtime {
@@ -117,6 +119,11 @@ class PerceptionStage {
   /// views whose own walls make none. A view whose pose is not there yet has its frame held when
   /// it comes, on a later step.
   PerceptionOutput step(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry);
+  /// The full results of the last step(), as the stages left them (the scene after the Manhattan
+  /// carry, the stairs stage's model): for an observer of the synchronous mode, valid until the
+  /// next step() or reconfigure().
+  const SceneResult& last_scene() const;
+  const StairResult& last_stair() const;
   void reconfigure(const PipelineConfig& config);
   bool available() const;
   std::string describe() const;

@@ -29,12 +29,25 @@
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/core/config.hpp"
 #include "stairguide/runtime/notifier.hpp"
+#include "stairguide/runtime/pipeline.hpp"
 
 namespace stairguide::runtime {
 
 /// Opens an input by name (default: open_frame_source). Throws SourceError.
 using SourceFactory =
     std::function<std::unique_ptr<FrameSource>(const std::string& input, const CaptureConfig&)>;
+
+/// One frame as synchronous mode ran it through every stage, for an observer (offline replay
+/// writes its files from these). The references are valid only during the call.
+struct FrameObservation {
+  const RgbdFrame& frame;
+  const FrameSource& source;           ///< the input: truth() of this frame, frame_count()
+  const OdometryOutput& odometry;      ///< after RuntimeOptions::pose_filter
+  const PerceptionOutput& perception;  ///< with the traversal result
+  const SceneResult& scene;            ///< perception's scene of this frame, after the Manhattan carry
+  const StairResult& stair;            ///< the stairs stage's full result
+  const std::string& cue;              ///< the cues decided on this frame ("" none)
+};
 
 struct RuntimeOptions {
   /// Input for open_frame_source: "device" / "device:URI" for the live camera (the default),
@@ -51,6 +64,12 @@ struct RuntimeOptions {
   /// Stop after this many frames (-1: until the input ends or stop is requested).
   long max_frames = -1;
   SourceFactory open_source;  ///< empty: open_frame_source
+  /// Called on the odometry's thread with each frame's odometry output before any stage uses its
+  /// pose (offline replay injects drift with it). Empty: none.
+  std::function<void(const RgbdFrame&, OdometryOutput&)> pose_filter;
+  /// Synchronous mode only: called on the calling thread once a frame has been through every
+  /// stage and the feedback decision. An exception it throws ends run() and reaches its caller.
+  std::function<void(const FrameObservation&)> observer;
 };
 
 /// Counters of a run. Rates are over the whole run unless named `interval_`.
@@ -128,6 +147,8 @@ class Runtime {
   /// 0 when the input ended cleanly or stop was requested, 1 when a replay failed mid-way (an
   /// unreadable frame).
   int exit_code() const;
+  /// Why a replay failed mid-way, naming the input and the frame ("" when it did not).
+  std::string failure() const;
 
   /// The input as the source describes it (after start()).
   std::string describe_input() const;

@@ -3,7 +3,10 @@
 // the classification in the paper's Fig. 3 f colours.
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <utility>
 #include <string>
 
 #include "cli/command.hpp"
@@ -12,6 +15,28 @@
 
 namespace stairguide::cli {
 namespace {
+
+// A legend of the region colours (the paper's Fig. 3f), bottom left, so the picture reads alone.
+void draw_class_legend(cv::Mat& img) {
+  const std::pair<RegionClass, const char*> items[] = {{RegionClass::kFloor, "floor"},
+                                                       {RegionClass::kStepCandidate, "step candidate (horizontal)"},
+                                                       {RegionClass::kVertical, "vertical (wall, riser)"},
+                                                       {RegionClass::kObstacle, "obstacle or other"},
+                                                       {RegionClass::kUnclassified, "unclassified"}};
+  const int n = static_cast<int>(std::size(items)), h = 18 * n + 8, w = 230;
+  const cv::Rect box(6, img.rows - h - 6, w, h);
+  if (box.y < 0 || box.width > img.cols) return;
+  cv::rectangle(img, box, cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::rectangle(img, box, cv::Scalar(0, 0, 0), 1);
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec3b c = region_class_color(items[i].first);
+    const int y = box.y + 16 + 18 * i;
+    cv::rectangle(img, cv::Point(box.x + 6, y - 10), cv::Point(box.x + 26, y), cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+    cv::putText(img, items[i].second, cv::Point(box.x + 32, y), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1,
+                cv::LINE_AA);
+  }
+}
+
 
 std::string json_escape(const std::string& s) {
   std::string o;
@@ -124,7 +149,8 @@ int analyze(Context& ctx) {
   }
   if (png) {
     const cv::Mat base = !frame.color.empty() ? frame.color : frame.gray;
-    const cv::Mat img = draw_classification(base, frame.depth, scene, perception.labels());
+    cv::Mat img = draw_classification(base, frame.depth, scene, perception.labels());
+    draw_class_legend(img);
     bool ok = false;
     try {
       ok = cv::imwrite(*png, img);
