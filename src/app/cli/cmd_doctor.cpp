@@ -78,6 +78,24 @@ std::string shell(const std::string& command) {
   return out;
 }
 
+std::vector<int> daemon_pids();
+
+/// A running daemon holds the camera, and may hold the sound device and the buzzer line: a device
+/// that is there but busy is then no fault of the setup. Such a failure becomes information,
+/// naming the daemon; a device that is missing altogether stays a failure.
+void judge_held_by_daemon(Check& c, const std::vector<int>& pids) {
+  if (c.status != Status::kFail || pids.empty()) return;
+  const std::string& m = c.message;
+  const bool busy = m.find("busy") != std::string::npos || m.find("Busy") != std::string::npos;
+  const bool held = c.name == "camera" ? m.find("cannot open") != std::string::npos || busy : busy;
+  if (!held) return;
+  c.status = Status::kInfo;
+  c.message = "in use by the running daemon (pid " + std::to_string(pids.front()) +
+              "), so not tried here: " + c.message + "; stop the daemon ('sudo systemctl stop stairguide') and "
+              "run the doctor again to try it";
+  c.fix.clear();
+}
+
 // ---- 1. config -------------------------------------------------------------------------------
 
 Check check_config(const std::string& path, PipelineConfig& config) {
@@ -488,7 +506,9 @@ Check check_rig() {
   }
   const std::vector<int> pids = daemon_pids();
   if (!pids.empty()) {
-    c.message = "stairguided runs outside the service (pid " + std::to_string(pids.front()) +
+    std::string list;
+    for (std::size_t i = 0; i < pids.size(); ++i) list += (i ? ", " : "") + std::to_string(pids[i]);
+    c.message = "stairguided runs outside the service (pid " + list +
                 "): the rig it learned is in its own log ('rig learned' lines)";
     return c;
   }
@@ -523,10 +543,15 @@ int doctor(Context& ctx) {
     }
     checks.push_back(std::move(c));
   };
+  const std::vector<int> daemons = daemon_pids();
+  auto held = [&](Check c) {
+    judge_held_by_daemon(c, daemons);
+    return c;
+  };
   run(check_config(ctx.config_path, config));
-  run(check_camera(config.capture));
-  run(check_sound(config.feedback));
-  run(check_buzzer(config.feedback));
+  run(held(check_camera(config.capture)));
+  run(held(check_sound(config.feedback)));
+  run(held(check_buzzer(config.feedback)));
   run(check_user(user, ctx.config_path, user == "stairguide"));
   run(check_sounds(config.feedback, user));
   run(check_rig());
