@@ -499,6 +499,9 @@ Check check_rig() {
     std::smatch m;
     if (std::regex_search(rig, m, std::regex("frame (\\d+): rig (learned|relearned): (.*)$")))
       c.message += "; rig " + m[2].str() + " at frame " + m[1].str() + ": " + m[3].str();
+    else if (geteuid() != 0 && rig.empty())
+      c.message += "; the rig it learned is in the journal, which this user may not read: run 'sudo "
+                   "stairguide doctor' to see it";
     else
       c.message += "; no rig learned yet: the daemon learns the camera's height and tilt from its first "
                    "clear views of the floor";
