@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
     }
     if (cfg && cfg->empty()) throw cli::UsageError("--config needs a file name, got an empty one");
     ctx.config_path = cfg ? *cfg : needs_default_config(name, ctx.args) ? default_config_path() : "";
-    if (!ctx.config_path.empty()) ctx.config = load_config(ctx.config_path);
+    // doctor loads the config itself: a broken one is the first thing it reports, not a reason to stop.
+    if (!ctx.config_path.empty() && name != "doctor") ctx.config = load_config(ctx.config_path);
     try {
       return cmd->fn(ctx);
     } catch (const cli::UsageError& e) {

@@ -34,22 +34,37 @@ __attribute__((section(".preinit_array"), used)) void (*const block_early)(int, 
 
 }  // namespace
 
+#ifndef STAIRGUIDED_CORE_FROM_BINDIR
+#define STAIRGUIDED_CORE_FROM_BINDIR "../libexec/stairguide/stairguided-core"
+#endif
+
+// Runs `dir`/`name` when it exists; returns only when it does not (0) or cannot be run (126).
+int exec_in(const char* dir, size_t dir_len, const char* name, char** argv) {
+  char path[PATH_MAX];
+  const size_t name_len = strlen(name);
+  if (dir_len + 1 + name_len + 1 > sizeof path) return 0;
+  memcpy(path, dir, dir_len);
+  path[dir_len] = '/';
+  memcpy(path + dir_len + 1, name, name_len + 1);
+  execv(path, argv);
+  if (errno == ENOENT || errno == ENOTDIR) return 0;
+  fprintf(stderr, "stairguided: cannot run %s: %s\n", path, strerror(errno));
+  return 126;
+}
+
 int main(int, char** argv) {
   block_stop_signals(0, nullptr, nullptr);
-  // The daemon beside this binary (the build tree), else where it is installed.
+  // The daemon beside this binary (the build tree), else where this install put it relative to
+  // this binary (any prefix, or an install staged under DESTDIR), else where it was configured.
   char self[PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-  static const char kName[] = "/stairguided-core";
   if (n > 0) {
     self[n] = '\0';
-    char* slash = strrchr(self, '/');
-    if (slash && static_cast<size_t>(slash - self) + sizeof kName <= sizeof self) {
-      memcpy(slash, kName, sizeof kName);
-      execv(self, argv);
-      if (errno != ENOENT) {
-        fprintf(stderr, "stairguided: cannot run %s: %s\n", self, strerror(errno));
-        return 126;
-      }
+    if (const char* slash = strrchr(self, '/')) {
+      const size_t dir_len = static_cast<size_t>(slash - self);
+      static const char* const kNames[] = {"stairguided-core", STAIRGUIDED_CORE_FROM_BINDIR};
+      for (const char* name : kNames)
+        if (const int code = exec_in(self, dir_len, name, argv)) return code;
     }
   }
   execv(STAIRGUIDED_CORE, argv);
