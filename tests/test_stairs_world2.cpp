@@ -121,6 +121,7 @@ TEST(StairsWorld2, TurnLabelsBothFlightsFromTheLanding) {
       RgbdFrame frame;
       FrameTruth truth;
       synth::render_preset_frame("world2_turn_static", i, seed, {}, frame, truth);
+      const synth::PresetFrame pf = synth::build_preset_frame("world2_turn_static", i, seed);
       ++frames;
       ASSERT_EQ(truth.stairs.size(), 2u);
       EXPECT_TRUE(truth.floor_visible || truth.stairs[0].visible_steps.size() + truth.stairs[1].visible_steps.size() > 0);
@@ -132,7 +133,6 @@ TEST(StairsWorld2, TurnLabelsBothFlightsFromTheLanding) {
         (s.kind == StairKind::kAscending ? up_seen : down_seen) += 1;
         full += s.first_edge_visible && s.both_ends_visible;
         // The angle between the view's heading and the flight's direction of travel.
-        const synth::PresetFrame pf = synth::build_preset_frame("world2_turn_static", i, seed);
         const Eigen::Vector3f t = pf.scene.stairs[static_cast<std::size_t>(s.id)].T_world_stair.linear().col(2);
         const Eigen::Vector2f a(view_dir.x(), view_dir.y()), b(t.x(), t.y());
         const float ang = rad2deg(std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.f, 1.f)));
@@ -421,17 +421,17 @@ TEST(StairsWorld2, FurnitureHasNoStairLabelAndIsInView) {
             EXPECT_GT(Eigen::Vector2f(c.x(), c.y()).norm(), 0.3f) << fu.preset << " " << so.label;
           }
       }
+      // Rendered (the truth of a scene without staircases has none: compute_truth labels only
+      // the scene's stairs), the piece covers 3% of the image or more.
       for (long i = 0; i < kRendered; ++i) {
-        RgbdFrame frame;
-        FrameTruth truth;
-        synth::render_preset_frame(fu.preset, i, seed, {}, frame, truth);
-        EXPECT_TRUE(truth.stairs.empty()) << fu.preset;
-        EXPECT_FALSE(truth.any_stair_visible());
         const synth::PresetFrame pf = synth::build_preset_frame(fu.preset, i, seed);
-        int px = 0;
-        for (const auto& [label, n] : label_pixels(pf))
+        int px = 0, all = 0;
+        for (const auto& [label, n] : label_pixels(pf)) {
           if (fu.labels.count(label)) px += n;
-        in_view += px * 33 >= frame.depth.rows * frame.depth.cols;
+          all += n;
+        }
+        in_view += px * 33 >= 640 * 480;
+        EXPECT_GT(all, 0);
         ++views;
       }
     }
