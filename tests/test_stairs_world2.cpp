@@ -555,7 +555,8 @@ synth::SynthOptions noise_options(const std::string& noise) {
 
 // Each preset's views run cold (perception from nothing, as `stairguide eval` runs the static
 // presets it knows), scored like eval. SG_WORLD2_PRESETS, SG_WORLD2_SEEDS (default 701 702),
-// SG_WORLD2_NOISE (any synth::sensor_options name; default white), SG_WORLD2_FRAMES (24).
+// SG_WORLD2_NOISE (any synth::sensor_options name; default white), SG_WORLD2_FRAMES (24),
+// SG_WORLD2_HEIGHT and SG_WORLD2_TILT (fix the camera's mounting).
 TEST(StairsWorld2, DISABLED_MeasureDetector) {
   std::vector<std::string> presets = split_env("SG_WORLD2_PRESETS", "");
   if (presets.empty())
@@ -563,6 +564,9 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
   const auto seeds = split_env("SG_WORLD2_SEEDS", "701 702");
   const std::string noise = split_env("SG_WORLD2_NOISE", "white").front();
   const long frames = std::atol(split_env("SG_WORLD2_FRAMES", "24").front().c_str());
+  // A fixed mounting instead of the preset's draw (SG_WORLD2_HEIGHT m, SG_WORLD2_TILT deg): to tell
+  // what the rig does from what the scene does.
+  const std::string height = split_env("SG_WORLD2_HEIGHT", "nan").front(), tilt = split_env("SG_WORLD2_TILT", "nan").front();
   std::printf("%-24s %-8s %-10s %6s %4s %4s %4s %4s %5s %10s %9s %9s\n", "preset", "noise", "seeds", "frames", "TP",
               "FP", "FN", "TN", "skip", "full", "riser cm", "tread cm");
   std::map<std::string, int> why;
@@ -572,6 +576,8 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
       const auto seed = static_cast<std::uint32_t>(std::stoul(seed_s));
       sgtest::SynthStairs p;
       p.options = noise_options(noise);
+      p.options.camera_height_m = std::stof(height);
+      p.options.camera_tilt_deg = std::stof(tilt);
       for (long i = 0; i < frames; ++i) {
         const StairResult& r = p.step(preset, i, seed, /*cold=*/true);
         const StairFrameEval e = evaluate_stair_frame(r, p.truth);
