@@ -587,10 +587,11 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
                                                 : std::string(to_string(r.verdict));
           ++why[std::string(to_string(e.outcome)) + " " + reason];
           std::printf("  miss %s seed %u #%ld: %s%s truth %s (%d treads) got %s %d levels (%s) riser %.1f tread %.1f "
-                      "floor %d\n",
+                      "floor %d (camera %.2f m, truth %.2f m)\n",
                       preset.c_str(), seed, i, to_string(e.outcome), e.fully_visible ? " fully visible" : "",
                       to_string(e.truth_kind), e.truth_visible_steps, r.detected ? to_string(r.kind) : "-", r.levels,
-                      to_string(r.verdict), 100 * r.riser_m, 100 * r.tread_m, p.scene.floor_found);
+                      to_string(r.verdict), 100 * r.riser_m, 100 * r.tread_m, p.scene.floor_found,
+                      p.scene.floor_found ? p.scene.camera_height : 0.f, p.truth.camera_height_m);
           for (const StairTruth& t : p.truth.stairs) {
             // Where a detection stood against each labelled flight: its origin's distance to the
             // flight's first edge line (eval matches within 25 cm).
