@@ -85,12 +85,68 @@ void apply_real_artefacts(const RenderBuffers& ideal, const SynthOptions& o, std
   }
 }
 
+// Time-of-flight multipath near concave corners (SynthOptions::multipath_m): per pixel, the
+// extra depth a reading gets from light bounced off a surface that faces it nearby. Normals come
+// from the ideal depth; a pixel and a neighbour up to multipath_range_m away that each lie in
+// front of the other's surface form a concave corner; the bias falls linearly with their distance.
+cv::Mat multipath_bias(const RenderBuffers& ideal, const CameraIntrinsics& K, const SynthOptions& o) {
+  const int W = ideal.depth.cols, H = ideal.depth.rows;
+  cv::Mat P(H, W, CV_32FC3, cv::Scalar(0, 0, 0)), N(H, W, CV_32FC3, cv::Scalar(0, 0, 0));
+  for (int v = 0; v < H; ++v) {
+    const float* z = ideal.depth.ptr<float>(v);
+    cv::Vec3f* p = P.ptr<cv::Vec3f>(v);
+    for (int u = 0; u < W; ++u)
+      if (z[u] > 0.f)
+        p[u] = cv::Vec3f((static_cast<float>(u) - K.cx) / K.fx * z[u], (static_cast<float>(v) - K.cy) / K.fy * z[u], z[u]);
+  }
+  auto vec = [](const cv::Vec3f& a) { return Eigen::Vector3f(a[0], a[1], a[2]); };
+  for (int v = 1; v + 1 < H; ++v)
+    for (int u = 1; u + 1 < W; ++u) {
+      const Eigen::Vector3f c = vec(P.at<cv::Vec3f>(v, u));
+      if (c.z() <= 0.f) continue;
+      const Eigen::Vector3f a = vec(P.at<cv::Vec3f>(v, u + 1)) - vec(P.at<cv::Vec3f>(v, u - 1));
+      const Eigen::Vector3f b = vec(P.at<cv::Vec3f>(v + 1, u)) - vec(P.at<cv::Vec3f>(v - 1, u));
+      const float lim = 0.05f + 0.02f * c.z();  // no normal across a depth jump
+      if (std::abs(a.z()) > lim || std::abs(b.z()) > lim || a.norm() == 0.f || b.norm() == 0.f) continue;
+      Eigen::Vector3f n = a.cross(b);
+      if (n.norm() < 1e-9f) continue;
+      n.normalize();
+      if (n.dot(c) > 0.f) n = -n;
+      N.at<cv::Vec3f>(v, u) = cv::Vec3f(n.x(), n.y(), n.z());
+    }
+  cv::Mat bias(H, W, CV_32FC1, cv::Scalar(0));
+  const int dirs[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}};
+  const float range = o.multipath_range_m;
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const cv::Vec3f np = N.at<cv::Vec3f>(v, u);
+      if (np[2] == 0.f && np[0] == 0.f && np[1] == 0.f) continue;
+      const Eigen::Vector3f p = vec(P.at<cv::Vec3f>(v, u)), n = vec(np);
+      const float r_px = std::clamp(K.fx * range / p.z(), 2.f, 60.f);
+      float w = 0.f;
+      for (const auto& d : dirs)
+        for (float s : {0.25f, 0.5f, 1.0f}) {
+          const int uu = u + static_cast<int>(std::lround(s * r_px * static_cast<float>(d[0])));
+          const int vv = v + static_cast<int>(std::lround(s * r_px * static_cast<float>(d[1])));
+          if (uu < 0 || vv < 0 || uu >= W || vv >= H) continue;
+          const cv::Vec3f nq = N.at<cv::Vec3f>(vv, uu);
+          if (nq[2] == 0.f && nq[0] == 0.f && nq[1] == 0.f) continue;
+          const Eigen::Vector3f e = vec(P.at<cv::Vec3f>(vv, uu)) - p;
+          const float dist = e.norm();
+          if (dist < 1e-3f || dist > range) continue;
+          if (e.dot(n) > 0.2f * dist && -e.dot(vec(nq)) > 0.2f * dist) w = std::max(w, 1.f - dist / range);
+        }
+      bias.at<float>(v, u) = o.multipath_m * w;
+    }
+  return bias;
+}
+
 }  // namespace
 
 float depth_sigma_model(float z, const SynthOptions& o) { return o.sigma_coeff * z * z; }
 
 SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o) {
-  if (sensor == RealSensor::kKinectV1) {
+  if (sensor == RealSensor::kKinectV1 || sensor == RealSensor::kStructuredLight) {
     o = with_real_kinect_noise(o);
   } else {
     o.time_of_flight = true;
@@ -99,12 +155,38 @@ SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o) {
     o.min_range_m = 0.5f;
     o.max_range_m = 4.5f;
   }
+  if (sensor == RealSensor::kKinectV2Native) {
+    // The Kinect v2's depth camera: 70.6 x 60 deg over 512 x 424 px (f = 256 / tan(35.3 deg) = 362;
+    // calibrations give 360-368). Multipath: errors of a few cm where two surfaces meet in a
+    // concave corner (Sarbolandi, Lefloch, Kolb 2015; Fuersattel et al. 2016).
+    o.focal_px = 365.f;
+    o.multipath_m = 0.02f;
+    o.multipath_range_m = 0.15f;
+  }
+  if (sensor == RealSensor::kStructuredLight) {
+    // The matcher's correlation window (9 x 9 px on the Kinect v1 / PrimeSense chips) straddling a
+    // depth jump finds no match: a band of about half a window is lost behind the edge.
+    o.edge_hole_px = 3;
+  }
   o.speckle_holes = 0.005f;
   o.dark_surface_chance = 0.1f;
   o.dark_surface_range_m = 2.0f;
   o.flying_pixels = 0.3f;
   return o;
 }
+
+bool sensor_options(const std::string& noise, SynthOptions& o) {
+  if (noise == "white") return true;
+  if (noise == "kinect") o = with_real_kinect_noise(o);
+  else if (noise == "real-v1") o = with_real_artefacts(RealSensor::kKinectV1, o);
+  else if (noise == "real-v2") o = with_real_artefacts(RealSensor::kKinectV2, o);
+  else if (noise == "tof-v2") o = with_real_artefacts(RealSensor::kKinectV2Native, o);
+  else if (noise == "sl-v1") o = with_real_artefacts(RealSensor::kStructuredLight, o);
+  else return false;
+  return true;
+}
+
+const char* sensor_names() { return "'white', 'kinect', 'real-v1', 'real-v2', 'tof-v2' or 'sl-v1'"; }
 
 SynthOptions with_real_kinect_noise(SynthOptions o) {
   o.noise_short_share = 0.6f;
@@ -149,6 +231,12 @@ void depth_sensor_holes(const RenderBuffers& ideal, const CameraIntrinsics& K, c
       if ((u > 0 && nearer(z[u - 1])) || (u + 1 < W && nearer(z[u + 1])) || (zu && nearer(zu[u])) ||
           (zd && nearer(zd[u])))
         hr[u] = 1;
+      // A structured-light matcher's window: the band up to edge_hole_px behind the jump.
+      for (int k = 2; k <= o.edge_hole_px && !hr[u]; ++k)
+        if ((u >= k && nearer(z[u - k])) || (u + k < W && nearer(z[u + k])) ||
+            (v >= k && nearer(ideal.depth.ptr<float>(v - k)[u])) ||
+            (v + k < H && nearer(ideal.depth.ptr<float>(v + k)[u])))
+          hr[u] = 1;
     }
     if (o.dark_surface_chance > 0.f) {
       // A dark face returns too little of the light beyond a range; a glossy one mirrors it away
@@ -243,6 +331,7 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
   Stream rng(seed);
   if (o.time_of_flight) {
     // Time of flight (Kinect v2): noise in depth itself, rounded to the driver's millimetre.
+    const cv::Mat mp = o.multipath_m > 0.f ? multipath_bias(ideal, K, o) : cv::Mat();
     for (int v = 0; v < H; ++v) {
       const float* z = ideal.depth.ptr<float>(v);
       float* out = depth_out.ptr<float>(v);
@@ -257,7 +346,8 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
         }
         float n = g[(r >> 48) & detail::kGaussianMask];
         if (cr) n = white_weight * n + cr[u];
-        const float zn = round_pos((zp + (o.tof_sigma_m + o.tof_sigma_per_m2 * zp * zp) * n) * inv_ds) * ds;
+        const float zm = mp.empty() ? zp : zp + mp.ptr<float>(v)[u];
+        const float zn = round_pos((zm + (o.tof_sigma_m + o.tof_sigma_per_m2 * zp * zp) * n) * inv_ds) * ds;
         out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
       }
     }

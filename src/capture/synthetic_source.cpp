@@ -29,6 +29,11 @@ void check_options(const SynthOptions& o) {
     bad("speckle_holes, dark_surface_chance and flying_pixels are shares in [0, 1]");
   if (!(o.dark_surface_range_m > 0.f)) bad("dark_surface_range_m must be positive");
   if (!(o.tof_sigma_m >= 0.f) || !(o.tof_sigma_per_m2 >= 0.f)) bad("time-of-flight sigmas must be >= 0");
+  if (!std::isnan(o.focal_px) && !(o.focal_px > 1.f && o.focal_px < 10000.f))
+    bad("focal length " + std::to_string(o.focal_px) + " px is out of range (1 .. 10000)");
+  if (!(o.multipath_m >= 0.f && o.multipath_m < 0.5f) || !(o.multipath_range_m > 0.f))
+    bad("multipath_m must be in [0, 0.5) m and multipath_range_m positive");
+  if (o.edge_hole_px < 1 || o.edge_hole_px > 16) bad("edge_hole_px must be 1 .. 16");
 }
 
 const detail::PresetDef& need_preset(const std::string& name) {
@@ -167,6 +172,7 @@ CameraIntrinsics synthetic_intrinsics(const SynthOptions& o) {
   K.height = o.height;
   K.fx = 525.f * sx;
   K.fy = 525.f * sy;
+  if (!std::isnan(o.focal_px)) K.fx = K.fy = o.focal_px;
   K.cx = (319.5f + 0.5f) * sx - 0.5f;
   K.cy = (239.5f + 0.5f) * sy - 0.5f;
   return K;

@@ -102,6 +102,18 @@ struct SynthOptions {
   bool time_of_flight = false;
   float tof_sigma_m = 0.0015f;       ///< m
   float tof_sigma_per_m2 = 0.0005f;  ///< 1/m
+  /// Time of flight only: multipath interference near concave corners (light reaching one
+  /// surface by way of the other comes back late), the depth reading up to multipath_m too far at
+  /// the corner and fading linearly to nothing multipath_range_m away from it. 0: none (every
+  /// suite before the second world).
+  float multipath_m = 0.f;
+  float multipath_range_m = 0.15f;  ///< m
+  /// px, the band lost on the far side of a depth jump (a structured-light matcher's window
+  /// straddling the jump); 1 = the neighbouring pixel only, as every suite before it was measured.
+  int edge_hole_px = 1;
+  /// px, focal length (fx = fy) at the output size; NaN: 525 px at 640x480 scaled with the size
+  /// (synthetic_intrinsics). A Kinect v2's own depth camera: about 365 px at 512x424.
+  float focal_px = std::numeric_limits<float>::quiet_NaN();
   float color_noise = 2.0f;          ///< grey levels, sigma of the colour noise
   double fps = 30.0;                 ///< Hz, frame rate of the timestamps
 };
@@ -113,8 +125,11 @@ struct SynthOptions {
 /// SyntheticNoiseCorrelatedAsTheRealClouds).
 SynthOptions with_real_kinect_noise(SynthOptions o = {});
 
-/// Which real sensor's artefacts with_real_artefacts() adds.
-enum class RealSensor { kKinectV1, kKinectV2 };
+/// Which real sensor's artefacts with_real_artefacts() adds. kKinectV2Native and
+/// kStructuredLight (the second world, issue 39) add what the first two left out: the Kinect v2's
+/// own depth camera (512x424, f 365 px, 70 x 60 deg) with multipath near concave corners, and a
+/// structured-light sensor's matcher losing a 3-px band behind depth edges.
+enum class RealSensor { kKinectV1, kKinectV2, kKinectV2Native, kStructuredLight };
 
 /// `o` with the artefacts of the real frames of ../shared/data: speckle holes (0.5% of the image),
 /// dark or glossy faces (one in ten: a dark one reads nothing beyond 2 m, a glossy one nothing
@@ -122,6 +137,15 @@ enum class RealSensor { kKinectV1, kKinectV2 };
 /// Kinect v1: the real-like correlated noise (with_real_kinect_noise) and its disparity
 /// quantisation; Kinect v2: time of flight at 512x424.
 SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o = {});
+
+/// The sensor model a synth: input's NOISE field names, applied to `o`: "white" (the defaults),
+/// "kinect" (with_real_kinect_noise), "real-v1" / "real-v2" (with_real_artefacts, Kinect v1 / v2),
+/// "tof-v2" (kKinectV2Native: the Kinect v2's own camera, multipath) and "sl-v1"
+/// (kStructuredLight: real-v1 with the matcher's 3-px band lost behind depth edges). False for
+/// any other name (`o` unchanged).
+bool sensor_options(const std::string& noise, SynthOptions& o);
+/// The names sensor_options() knows, for messages.
+const char* sensor_names();
 
 /// Everything needed to render one frame of a preset: the scene and the walker's state.
 struct PresetFrame {
