@@ -44,16 +44,8 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
   std::uint32_t seed = 1;
   if (parts.size() >= 4 && !parts[3].empty()) seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
   synth::SynthOptions options;
-  if (parts.size() == 5) {
-    if (parts[4] == "kinect") options = synth::with_real_kinect_noise(options);
-    else if (parts[4] == "real-v1")
-      options = synth::with_real_artefacts(synth::RealSensor::kKinectV1, options);
-    else if (parts[4] == "real-v2")
-      options = synth::with_real_artefacts(synth::RealSensor::kKinectV2, options);
-    else if (parts[4] != "white")
-      throw SourceError("input '" + input +
-                        "': NOISE must be 'white', 'kinect', 'real-v1' or 'real-v2', got '" + parts[4] + "'");
-  }
+  if (parts.size() == 5 && !synth::sensor_options(parts[4], options))
+    throw SourceError("input '" + input + "': NOISE must be " + synth::sensor_names() + ", got '" + parts[4] + "'");
   // An unknown scene name is reported by make_source (its message lists the presets).
   return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed, options);
 }

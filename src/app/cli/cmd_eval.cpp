@@ -27,6 +27,8 @@ bool is_static_preset(const std::string& name) {
     if (p.name == name) return p.default_frames == 1;
   for (const auto& p : synth::world_presets())
     if (p.name == name) return p.default_frames == 1;
+  for (const auto& p : synth::world2_presets())
+    if (p.name == name) return p.default_frames == 1;
   return false;
 }
 
