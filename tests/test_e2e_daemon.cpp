@@ -271,7 +271,7 @@ TEST_F(DaemonE2E, UnreadableOrInvalidConfigIsNamedAndNothingRuns) {
 }
 
 // The unit as installed points at the installed binary; verify it with the built one in its place.
-TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost2_5) {
+TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost0_8) {
   std::string out;
   if (run_capture("command -v systemd-analyze", out) != 0) GTEST_SKIP() << "systemd-analyze not installed";
   fs::create_directories(kDir);
@@ -290,12 +290,15 @@ TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost2_5) {
   ASSERT_TRUE(
       std::regex_search(out, m, std::regex("Overall exposure level for stairguide.service: ([0-9.]+)")))
       << out;
-  EXPECT_LE(std::stod(m[1]), 2.5) << out;
+  // 0.8 as the unit stands (issue 41: it was 1.0 while the README said 0.8; PrivateMounts=yes took
+  // it there). What is left is what the daemon needs: the devices, their groups, the buzzer's
+  // real-time priority (sched_setscheduler, from @resources), AF_UNIX and AF_NETLINK.
+  EXPECT_LE(std::stod(m[1]), 0.8) << out;
 
   // What the daemon relies on is in the unit.
   for (const char* key : {"Type=notify", "WatchdogSec=", "User=stairguide", "ExecReload=",
                           "DevicePolicy=closed", "DeviceAllow=char-usb_device rw", "DeviceAllow=char-alsa rw",
-                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio"})
+                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio", "PrivateMounts=yes"})
     EXPECT_NE(unit.find(key), std::string::npos) << key;
 }
 
