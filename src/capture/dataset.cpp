@@ -26,8 +26,9 @@ namespace stairguide {
 
 DatasetCamera read_camera_yaml(const std::string& path) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw SourceError(path + ": " + (fs::exists(path, ec) ? "not a regular file" : "missing (no such file)"));
+  if (const std::string why = why_unreadable(path); !why.empty())
+    throw SourceError(path + ": " + unreadable_words(why, "it"));
+  if (!fs::is_regular_file(path, ec)) throw SourceError(path + ": not a regular file");
   YAML::Node root;
   try {
     // Seven numbers and comments: 64 KiB and 1000 nodes are far more than one holds.
@@ -175,7 +176,11 @@ std::vector<TimedPose> read_groundtruth(const std::string& path) {
 
 DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& options) : dir_(dir) {
   std::error_code ec;
-  if (!fs::exists(dir, ec)) throw SourceError("dataset " + dir + ": folder missing (no such directory)");
+  if (const std::string why = why_unreadable(dir, true); !why.empty()) {
+    if (why == "no such file") throw SourceError("dataset " + dir + ": folder missing (no such directory)");
+    if (!(fs::exists(dir, ec) && !fs::is_directory(dir, ec)))  // else: a file, said below
+      throw SourceError("dataset " + dir + ": cannot read the folder (" + why + ")");
+  }
   if (!fs::is_directory(dir, ec)) throw SourceError("dataset " + dir + ": not a directory");
   const fs::path d(dir);
   camera_ = read_camera_yaml((d / "camera.yaml").string());
@@ -248,7 +253,9 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
     return ReadResult{ReadStatus::kError, file + ": " + why};
   };
   // Existence first: imread cannot tell a missing file from a corrupt one.
-  if (!fs::exists(p.depth_path, ec)) return fail(p.depth_path, "depth image missing");
+  // And readable: an unreadable image read as "corrupt" (issue 41).
+  if (const std::string why = why_unreadable(p.depth_path); !why.empty())
+    return fail(p.depth_path, why == "no such file" ? "depth image missing" : "cannot read depth image (" + why + ")");
   cv::Mat raw = cv::imread(p.depth_path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) return fail(p.depth_path, "cannot decode depth image (corrupt or not an image)");
   if (raw.type() != CV_16UC1)
@@ -260,7 +267,9 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
                                   std::to_string(k.height));
   raw.convertTo(out.depth, CV_32F, 1.0 / camera_.depth_scale);
   if (!p.color_path.empty()) {
-    if (!fs::exists(p.color_path, ec)) return fail(p.color_path, "colour image missing");
+    if (const std::string why = why_unreadable(p.color_path); !why.empty())
+      return fail(p.color_path,
+                  why == "no such file" ? "colour image missing" : "cannot read colour image (" + why + ")");
     cv::Mat c = cv::imread(p.color_path, cv::IMREAD_COLOR);
     if (c.empty()) return fail(p.color_path, "cannot decode colour image (corrupt or not an image)");
     if (c.cols != k.width || c.rows != k.height)
