@@ -16,6 +16,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "daemon_test_util.hpp"
@@ -228,8 +229,76 @@ TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {
     ASSERT_TRUE(d.read_line(l, 5)) << "the daemon kept running";
     EXPECT_EQ(parse_kv(l).at("cfg"), "2");
   }
+
+  // An empty file (an editor that truncates before it writes): refused, the running config kept
+  // (issue 41: every key went back to its default).
+  write_file(cfg, "# being edited\n\n");
+  d.signal(SIGHUP);
+  const auto until2 = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < until2 && d.stderr_text().find("the config is empty") == std::string::npos)
+    d.read_line(l, 0.1);
+  EXPECT_NE(d.stderr_text().find("config reload rejected, keeping the running config: " + cfg.string() +
+                                 ": the config is empty"),
+            std::string::npos)
+      << d.stderr_text();
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(d.read_line(l, 5)) << "the daemon kept running";
+    EXPECT_EQ(parse_kv(l).at("cfg"), "2");
+  }
   d.signal(SIGTERM);
   EXPECT_EQ(d.wait_exit(5.0), 0);
+}
+
+// Issue 41: 50 SIGHUPs of an unchanged config in a second, before the flight, delayed "first step"
+// by 25 frames and said "6 steps left" where it was 5. Through the whole daemon (one thread, paced
+// as the camera would give the frames, so every frame's decision can be compared), a storm leaves
+// every frame's decision as in a run without it.
+TEST_F(DaemonE2E, ABurstOfSighupsOfAnUnchangedConfigLeavesEveryDecisionAsWithout) {
+  auto run = [&](bool storm) {
+    const std::string name = storm ? "storm" : "calm";
+    const fs::path cfg = kDir / (name + ".yaml");
+    fs::copy_file(config_, cfg, fs::copy_options::overwrite_existing);
+    Daemon d({"--config", cfg.string(), "--replay", oni_.string(), "--realtime", "--sync"}, io(name));
+    EXPECT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
+    std::vector<std::string> lines;
+    std::string l;
+    if (storm) {
+      for (int i = 0; i < 10 && d.read_line(l, 10); ++i) lines.push_back(l);
+      for (int i = 0; i < 50; ++i) {
+        d.signal(SIGHUP);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        while (d.read_line(l, 0.0)) lines.push_back(l);
+      }
+    }
+    EXPECT_EQ(d.wait_exit(120.0, &lines), 0) << d.stderr_text();
+    if (storm) {
+      const std::string err = d.stderr_text();
+      EXPECT_NE(err.find("unchanged; the running config and its state are kept"), std::string::npos) << err;
+      EXPECT_EQ(err.find("config reloaded from"), std::string::npos) << err;
+    }
+    std::vector<std::string> out;
+    for (const auto& line : lines) {
+      if (line.rfind("frame=", 0) != 0) continue;
+      auto kv = parse_kv(line);
+      std::string keep;
+      for (const char* k : {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left", "known",
+                            "cue"})
+        keep += std::string(k) + "=" + kv[k] + " ";
+      out.push_back(keep);
+    }
+    return out;
+  };
+  const auto calm = run(false), storm = run(true);
+  ASSERT_EQ(calm.size(), static_cast<std::size_t>(kOniFrames));
+  ASSERT_EQ(storm.size(), calm.size());
+  int steps = 0;
+  for (std::size_t i = 0; i < calm.size(); ++i) {
+    EXPECT_EQ(storm[i], calm[i]) << "frame " << i;
+    steps += calm[i].find(" step=0 ") == std::string::npos;
+  }
+  std::printf("%d of %zu frames on a step, every decision identical with and without 50 SIGHUPs\n", steps,
+              calm.size());
+  EXPECT_GT(steps, 0) << "the recording has no flight to count";
 }
 
 TEST_F(DaemonE2E, CorruptOrMissingRecordingFailsWithAClearMessage) {
@@ -268,6 +337,41 @@ TEST_F(DaemonE2E, UnreadableOrInvalidConfigIsNamedAndNothingRuns) {
   EXPECT_NE(run_capture(std::string(STAIRGUIDED) + " --check-config " + bad.string(), out), 0);
   EXPECT_NE(out.find("ring_capacity"), std::string::npos) << out;
   EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --bogus", out), 2);
+  // An empty config is invalid at start too, the file named (issue 41: check-config called it valid).
+  const fs::path empty = kDir / "empty.yaml";
+  write_file(empty, "   \n# nothing yet\n");
+  EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --check-config " + empty.string(), out), 3) << out;
+  EXPECT_NE(out.find(empty.string() + ": the config is empty"), std::string::npos) << out;
+  {
+    Daemon d({"--config", empty.string(), "--replay", oni_.string()}, io("emptyconfig"));
+    EXPECT_EQ(d.wait_exit(10.0), 3);
+    EXPECT_NE(d.stderr_text().find("the config is empty"), std::string::npos) << d.stderr_text();
+  }
+}
+
+// Issue 41: under a 250 MB address-space limit the daemon died of an uncaught std::bad_alloc (exit
+// 134, no log line). At any limit it now ends either well or with a line naming the memory and a
+// non-zero exit (5 while starting, 1 once running), never through a signal. Where it runs out
+// depends on the machine (before the first log line at 256000 kB here, in OpenCV at 270000 kB).
+TEST(DaemonMemory, UnderATightAddressSpaceLimitItSaysOutOfMemoryAndExitsNonZero) {
+  // (Below about 250000 kB the dynamic loader itself cannot map the libraries: exit 127, before
+  // any of the daemon's code runs.)
+  for (const int kb : {256000, 270000, 300000}) {
+    std::string out;
+    const int rc = run_capture("ulimit -v " + std::to_string(kb) + "; exec " + std::string(STAIRGUIDED) +
+                                   " --replay synth:climb_3_steps:5 --fast --sync --no-frame-lines",
+                               out);
+    std::printf("ulimit -v %d: exit %d\n", kb, rc);
+    EXPECT_EQ(out.find("terminate called"), std::string::npos) << kb << ": " << out;
+    if (rc == 0) {
+      EXPECT_NE(out.find("summary frames=5"), std::string::npos) << kb << ": " << out;
+      continue;
+    }
+    EXPECT_TRUE(rc == 1 || rc == 5) << kb << ": exit " << rc << "\n" << out;
+    EXPECT_TRUE(out.find("out of memory") != std::string::npos ||
+                out.find("Insufficient memory") != std::string::npos)
+        << kb << ": " << out;
+  }
 }
 
 // The unit as installed points at the installed binary; verify it with the built one in its place.

@@ -136,8 +136,6 @@ void block_stop_signals(int, char**, char**) {
 __attribute__((section(".preinit_array"),
                used)) void (*const block_stop_signals_early)(int, char**, char**) = block_stop_signals;
 
-}  // namespace
-
 /// The last word when memory ran out outside the runtime's threads (they log their own): a
 /// message that needs no allocation when even logging cannot have any.
 void say_out_of_memory(const char* where) noexcept {
