@@ -479,3 +479,30 @@ TEST(RealData, KinectPcdFramesAndEstimatedIntrinsics) {
   const std::string e = error_of([&] { read_pcd_frame((root / "no-such.pcd").string()); });
   EXPECT_NE(e.find("no-such.pcd"), std::string::npos) << e;
 }
+
+// Issue 41: with a clock that jumps back 5 s, frame 300's time was frame 150's and nearest-time
+// pairing gave it frame 150's colour; with equal times every depth image took the first colour
+// image. Lists whose times do not grow are paired in file order.
+TEST(Dataset, ListsWhoseClockJumpsBackOrStandsStillArePairedInFileOrder) {
+  const auto frames = make_frames(8, 16, 12, 9);
+  for (const char* kind : {"back", "equal"}) {
+    const fs::path d = scratch(std::string("clock_") + kind);
+    {
+      DatasetWriter w(d.string(), frames[0].intrinsics);
+      for (std::size_t i = 0; i < frames.size(); ++i) {
+        RgbdFrame f = frames[i];
+        f.timestamp = std::string(kind) == "equal" ? 3.0 : 1.0 + 0.1 * static_cast<double>(i) - (i >= 4 ? 0.4 : 0.0);
+        w.write(f);
+      }
+      w.close();
+    }
+    DatasetSource s(d.string());
+    RgbdFrame f;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      ASSERT_TRUE(s.read(f).ok()) << kind << " " << i;
+      ASSERT_FALSE(f.color.empty()) << kind << " " << i;
+      EXPECT_EQ(cv::norm(f.color, frames[i].color, cv::NORM_INF), 0.0) << kind << ": frame " << i
+                                                                        << " got another frame's colour";
+    }
+  }
+}

@@ -6,12 +6,15 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "capture_test_util.hpp"
@@ -314,7 +317,7 @@ TEST(HostileOni, RecordsOpenNI2sPlayerWouldTrustAreRefusedBeforeItSeesThem) {
       {24 + 16, le32(999), "record at byte 24: a payload on a record that has none"},
       // Also found by fuzz_oni: OpenNI2's player allocated 6 GB for the streams this announced.
       {20, le32(2752514), "the file header announces 2752514 streams"},
-      {crop + 9, "G", "stream 2 has no xnCropping property"},
+      {crop + 9, "G", "stream 2 carries frames but has no xnCropping property before them"},
   };
   for (const auto& c : cases) {
     std::string mutated = bytes;
@@ -325,4 +328,192 @@ TEST(HostileOni, RecordsOpenNI2sPlayerWouldTrustAreRefusedBeforeItSeesThem) {
     EXPECT_NE(e.find("mutated.oni: corrupt recording ("), std::string::npos) << e;
     EXPECT_NE(e.find(c.expect), std::string::npos) << e;
   }
+}
+
+namespace {
+
+struct OniRecord {
+  std::size_t at, size;
+  std::uint32_t type, node;
+  std::string name;  // of a property record
+};
+
+std::uint32_t get32(const std::string& b, std::size_t at) {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 2])) << 16 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
+}
+
+std::vector<OniRecord> oni_records(const std::string& b) {
+  std::vector<OniRecord> out;
+  for (std::size_t pos = 24; pos + 28 <= b.size();) {
+    OniRecord r{pos, get32(b, pos + 12) + std::size_t{get32(b, pos + 16)}, get32(b, pos + 4), get32(b, pos + 8), ""};
+    if (r.type >= 0x03 && r.type <= 0x06) r.name = b.substr(pos + 32, get32(b, pos + 28) - 1);
+    out.push_back(r);
+    if (r.type == 0x0B) break;
+    pos += r.size;
+  }
+  return out;
+}
+
+}  // namespace
+
+// Issue 41: a real Kinect recording that OpenNI2's own player reads was refused as "corrupt (stream 1
+// has no xnCropping property)": the check wanted the property before the stream's ready record,
+// where OpenNI2's player only needs it before the stream's frames. The same recording as OniWriter
+// writes it, with the depth stream's cropping record moved after its ready record (and the colour
+// stream's after its data-begin record), plays every frame.
+TEST(HostileOni, CroppingAfterTheStreamIsReadyPlaysAsOpenNI2sPlayerDoes) {
+  const fs::path good = scratch("late_crop_src.oni");
+  const auto frames = test::make_frames(3, 32, 24, 1, 3000, 5.0);
+  {
+    OniWriter w(good.string(), frames[0].intrinsics, true);
+    for (const auto& f : frames) w.write(f);
+    w.close();
+  }
+  std::string b = read_all(good);
+  const auto recs = oni_records(b);
+  // Moves record i to just after record j (i < j): the records between shift back, nothing else moves.
+  auto move_after = [&](std::size_t i, std::size_t j) {
+    const std::string rec = b.substr(recs[i].at, recs[i].size);
+    const std::size_t end = recs[j].at + recs[j].size;
+    const std::string between = b.substr(recs[i].at + recs[i].size, end - recs[i].at - recs[i].size);
+    b.replace(recs[i].at, end - recs[i].at, between + rec);
+  };
+  auto find = [&](std::uint32_t node, std::uint32_t type, const char* name) {
+    for (std::size_t i = 0; i < recs.size(); ++i)
+      if (recs[i].node == node && recs[i].type == type && (!name || recs[i].name == name)) return i;
+    ADD_FAILURE() << "no record " << type << " of node " << node;
+    return std::size_t{0};
+  };
+  // Colour (node 2) first: its records lie after the depth stream's, whose move shifts nothing of them.
+  move_after(find(2, 0x06, "xnCropping"), find(2, 0x08, nullptr));
+  move_after(find(1, 0x06, "xnCropping"), find(1, 0x09, nullptr));
+  const fs::path late = scratch("late_crop.oni");
+  write_bytes(late, b);
+  OniSource s(late.string());
+  RgbdFrame f;
+  int n = 0;
+  while (s.read(f).ok()) {
+    EXPECT_EQ(f.depth.cols, 32);
+    EXPECT_FALSE(f.color.empty()) << "frame " << n;
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+}
+
+// Issue 41: permission denied read "missing (no such file)", "depth image missing" or "corrupt", and a
+// symlink loop as the input "no such file". Each is named by its cause. Root passes every
+// permission check, so as root the readers run in a child that has become `nobody`.
+TEST(HostileFiles, PermissionDeniedAndSymlinkLoopsAreNamedByTheirCause) {
+  EXPECT_EQ(why_unreadable("/nonexistent/sg"), "no such file");
+  EXPECT_EQ(errno_words(EACCES), "permission denied");
+  EXPECT_EQ(errno_words(ELOOP), "a symbolic link loop (too many levels of symbolic links)");
+
+  char tmpl[] = "/tmp/sg-perm-XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const fs::path root(tmpl);
+  fs::permissions(root, fs::perms(0755));
+  const auto frames = test::make_frames(1, 32, 24, 3, 3000, 1.0);
+  auto dataset = [&](const fs::path& d) {
+    DatasetWriter w(d.string(), frames[0].intrinsics);
+    w.write(frames[0]);
+    w.close();
+  };
+  const fs::path closed = root / "closed", open_img = root / "open_img", shut = root / "shut";
+  dataset(closed);
+  dataset(open_img);
+  fs::create_directories(shut);
+  dataset(shut / "inner");
+  fs::path depth_png;
+  for (const auto& e : fs::recursive_directory_iterator(open_img))
+    if (e.path().extension() == ".png" && e.path().string().find("depth") != std::string::npos) depth_png = e.path();
+  ASSERT_FALSE(depth_png.empty());
+  const fs::path oni = root / "rec.oni";
+  {
+    OniWriter w(oni.string(), frames[0].intrinsics, false);
+    w.write(frames[0]);
+    w.close();
+  }
+  fs::permissions(closed, fs::perms::none);
+  fs::permissions(depth_png, fs::perms::none);
+  fs::permissions(oni, fs::perms::none);
+  fs::permissions(shut, fs::perms::none);
+
+  // The messages, one per line, from whoever may not read these.
+  auto messages = [&] {
+    std::string out;
+    auto say = [&](const std::function<void()>& f) {
+      try {
+        f();
+        out += "(no error)\n";
+      } catch (const std::exception& e) {
+        out += std::string(e.what()) + "\n";
+      }
+    };
+    const CaptureConfig cc;
+    say([&] { DatasetSource s(closed.string()); });
+    say([&] {
+      DatasetSource s(open_img.string());
+      RgbdFrame f;
+      const ReadResult r = s.read(f);
+      throw std::runtime_error(r.ok() ? "(read)" : r.message);
+    });
+    say([&] { OniSource s(oni.string()); });
+    say([&] { open_frame_source((shut / "inner").string(), cc); });
+    return out;
+  };
+  std::string got;
+  if (geteuid() == 0) {
+    int p[2];
+    ASSERT_EQ(pipe(p), 0);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      close(p[0]);
+      if (setgid(65534) != 0 || setuid(65534) != 0) _exit(3);
+      const std::string m = messages();
+      const ssize_t n = write(p[1], m.data(), m.size());
+      _exit(n == static_cast<ssize_t>(m.size()) ? 0 : 4);
+    }
+    close(p[1]);
+    char buf[4096];
+    for (ssize_t n; (n = read(p[0], buf, sizeof buf)) > 0;) got.append(buf, static_cast<std::size_t>(n));
+    close(p[0]);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "child status " << st;
+  } else {
+    got = messages();
+  }
+  std::istringstream in(got);
+  std::vector<std::string> m;
+  for (std::string l; std::getline(in, l);) m.push_back(l);
+  ASSERT_EQ(m.size(), 4u) << got;
+  EXPECT_NE(m[0].find("dataset " + closed.string() + ": cannot read the folder (permission denied)"),
+            std::string::npos)
+      << m[0];
+  EXPECT_NE(m[1].find(depth_png.string() + ": cannot read depth image (permission denied)"), std::string::npos)
+      << m[1];
+  EXPECT_NE(m[2].find("oni " + oni.string() + ": cannot read the recording (permission denied)"),
+            std::string::npos)
+      << m[2];
+  EXPECT_NE(m[3].find("cannot open it (permission denied)"), std::string::npos) << m[3];
+  for (const auto& l : m)
+    for (const char* wrong : {"no such", "missing", "corrupt"}) EXPECT_EQ(l.find(wrong), std::string::npos) << l;
+
+  // A symlink loop as the input.
+  fs::create_symlink("loop", root / "loop");
+  fs::create_symlink("loop.oni", root / "loop.oni");
+  for (const char* name : {"loop", "loop.oni"}) {
+    std::string e;
+    try {
+      open_frame_source((root / name).string(), CaptureConfig{});
+    } catch (const SourceError& x) {
+      e = x.what();
+    }
+    EXPECT_NE(e.find("a symbolic link loop"), std::string::npos) << name << ": " << e;
+  }
+  for (const fs::path& p : {closed, shut}) fs::permissions(p, fs::perms(0755));
+  fs::remove_all(root);
 }

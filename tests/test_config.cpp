@@ -216,9 +216,33 @@ TEST(Config, YamlSyntaxErrorHasLine) {
   EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
 }
 
-TEST(Config, EmptyFileGivesDefaults) {
-  const PipelineConfig c = load_config(write_tmp("empty", "# nothing\n"));
+// Issue 41: an empty file (an editor that truncates before writing, then a SIGHUP) put every key
+// back to its default, silently. Empty, blank and comment-only files are refused, naming the file;
+// an explicit empty mapping still asks for the defaults.
+TEST(Config, EmptyFileIsRefusedNamingTheFile) {
+  for (const char* text : {"", "   \n\n\t\n", "# nothing\n# at all\n", "---\n", "\n# only a comment\n  \n"}) {
+    const std::string path = write_tmp("empty", text);
+    try {
+      load_config(path);
+      FAIL() << "an empty config was taken: '" << text << "'";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": the config is empty"), std::string::npos) << e.what();
+    }
+  }
+  const PipelineConfig c = load_config(write_tmp("braces", "{}\n"));
   EXPECT_TRUE(config_equal(c, PipelineConfig{}));
+}
+
+// Issue 41: ring_capacity 1024 was in range, and with a slow odometry 1.4 GB of frames queued and
+// the poses came 20 s late. The range holds at most about a second of frames at 30 Hz.
+TEST(Config, RingCapacityHoldsAtMostASecondOfFrames) {
+  for (const char* v : {"1024", "31", "64"}) {
+    const std::string e = error_of("ring", std::string("runtime:\n  ring_capacity: ") + v + "\n");
+    EXPECT_NE(e.find("key 'runtime.ring_capacity': value " + std::string(v) + " is out of range [2, 30]"),
+              std::string::npos)
+        << e;
+  }
+  EXPECT_EQ(load_config_text("runtime:\n  ring_capacity: 30\n", "ok.yaml").runtime.ring_capacity, 30);
 }
 
 // ---- issue 35: hostile config files ----

@@ -16,9 +16,11 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "daemon_test_util.hpp"
+#include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
 #include "stairguide/capture/synthetic.hpp"
 #include "stairguide/config/config_loader.hpp"
@@ -228,8 +230,157 @@ TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {
     ASSERT_TRUE(d.read_line(l, 5)) << "the daemon kept running";
     EXPECT_EQ(parse_kv(l).at("cfg"), "2");
   }
+
+  // An empty file (an editor that truncates before it writes): refused, the running config kept
+  // (issue 41: every key went back to its default).
+  write_file(cfg, "# being edited\n\n");
+  d.signal(SIGHUP);
+  const auto until2 = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < until2 && d.stderr_text().find("the config is empty") == std::string::npos)
+    d.read_line(l, 0.1);
+  EXPECT_NE(d.stderr_text().find("config reload rejected, keeping the running config: " + cfg.string() +
+                                 ": the config is empty"),
+            std::string::npos)
+      << d.stderr_text();
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(d.read_line(l, 5)) << "the daemon kept running";
+    EXPECT_EQ(parse_kv(l).at("cfg"), "2");
+  }
   d.signal(SIGTERM);
   EXPECT_EQ(d.wait_exit(5.0), 0);
+}
+
+// Issue 41: 50 SIGHUPs of an unchanged config in a second, before the flight, delayed "first step"
+// by 25 frames and said "6 steps left" where it was 5. Through the whole daemon on a climb of 8 steps
+// (one thread, paced as the camera would give the frames, so every frame's decision can be
+// compared), a storm with the stairs ahead leaves every frame's decision as in a run without it.
+TEST_F(DaemonE2E, ABurstOfSighupsOfAnUnchangedConfigLeavesEveryDecisionAsWithout) {
+  auto run = [&](bool storm) {
+    const std::string name = storm ? "storm" : "calm";
+    const fs::path cfg = kDir / (name + ".yaml");
+    fs::copy_file(config_, cfg, fs::copy_options::overwrite_existing);
+    Daemon d({"--config", cfg.string(), "--replay", "synth:climb_8_steps", "--realtime", "--sync"}, io(name));
+    EXPECT_TRUE(d.wait_notify("READY=1", 30)) << d.stderr_text();
+    std::vector<std::string> lines;
+    std::string l;
+    if (storm) {
+      for (int i = 0; i < 130 && d.read_line(l, 30); ++i) lines.push_back(l);
+      for (int i = 0; i < 50; ++i) {
+        d.signal(SIGHUP);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        while (d.read_line(l, 0.0)) lines.push_back(l);
+      }
+    }
+    EXPECT_EQ(d.wait_exit(600.0, &lines), 0) << d.stderr_text();
+    if (storm) {
+      const std::string err = d.stderr_text();
+      EXPECT_NE(err.find("unchanged; the running config and its state are kept"), std::string::npos) << err;
+      EXPECT_EQ(err.find("config reloaded from"), std::string::npos) << err;
+    }
+    std::vector<std::string> out;
+    for (const auto& line : lines) {
+      if (line.rfind("frame=", 0) != 0) continue;
+      auto kv = parse_kv(line);
+      std::string keep;
+      for (const char* k : {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left", "known",
+                            "cue"})
+        keep += std::string(k) + "=" + kv[k] + " ";
+      out.push_back(keep);
+    }
+    return out;
+  };
+  const auto calm = run(false), storm = run(true);
+  ASSERT_GT(calm.size(), 300u);
+  ASSERT_EQ(storm.size(), calm.size());
+  int steps = 0;
+  for (std::size_t i = 0; i < calm.size(); ++i) {
+    EXPECT_EQ(storm[i], calm[i]) << "frame " << i;
+    steps += calm[i].find(" step=0 ") == std::string::npos;
+  }
+  std::printf("%d of %zu frames on a step, every decision identical with and without 50 SIGHUPs\n", steps,
+              calm.size());
+  EXPECT_GT(steps, 100) << "the walk has no flight to count";
+}
+
+// Issue 41: a dataset whose clock jumps back 5 s mid-flight counted 6 of 8 steps, exit 0 and no
+// warning. The daemon warns naming the frame, times it by the frame clock, and every frame's
+// decision is that of the same dataset with a good clock (a climb of 8 steps at 320x240, the
+// clock jumping back on frame 300, on the flight).
+TEST_F(DaemonE2E, ADatasetWhoseClockJumpsBackIsWarnedAndCountsAsWithAGoodClock) {
+  const long frames = synth::find_preset_info("climb_8_steps")->default_frames;
+  auto write = [&](const std::string& name, double jump_at) {
+    const fs::path dir = kDir / name;
+    fs::remove_all(dir);
+    synth::SynthOptions so;
+    so.width = 320;
+    so.height = 240;
+    auto src = synth::make_source("climb_8_steps", frames, 7, so);
+    DatasetWriter w(dir.string(), src->intrinsics());
+    RgbdFrame f;
+    for (long i = 0; i < frames && src->read(f).ok(); ++i) {
+      if (i >= jump_at) f.timestamp -= 5.0;
+      w.write(f);
+    }
+    w.close();
+    return dir;
+  };
+  auto run = [&](const fs::path& dir, const std::string& name, std::string* err) {
+    Daemon d({"--config", config_.string(), "--replay", dir.string(), "--fast", "--sync"}, io(name));
+    std::vector<std::string> lines;
+    EXPECT_EQ(d.wait_exit(300.0, &lines), 0) << d.stderr_text();
+    if (err) *err = d.stderr_text();
+    std::vector<std::string> out;
+    for (const auto& line : lines) {
+      if (line.rfind("frame=", 0) != 0) continue;
+      auto kv = parse_kv(line);
+      std::string keep;
+      for (const char* k : {"frame", "odom", "perception", "manhattan", "traversal", "step", "left", "known", "cue"})
+        keep += std::string(k) + "=" + kv[k] + " ";
+      out.push_back(keep);
+    }
+    return out;
+  };
+  const auto good = run(write("clock_good", 1e9), "clock_good", nullptr);
+  std::string err;
+  const auto jumped = run(write("clock_back", 300), "clock_back", &err);
+  ASSERT_EQ(good.size(), static_cast<std::size_t>(frames));
+  ASSERT_EQ(jumped.size(), good.size());
+  // The frames after the jump are timed a few tens of nanoseconds off the good clock (depth.txt
+  // holds microseconds; the frame clock steps one nominal period): a state that changes on a time
+  // limit may change one frame apart. Every state, count and cue comes, in the same order, and
+  // all but a few frames are identical.
+  auto field = [](const std::string& line, const std::string& key) {
+    const auto at = line.find(" " + key + "=");
+    return line.substr(at + key.size() + 2, line.find(' ', at + 1) - at - key.size() - 2);
+  };
+  auto story = [&](const std::vector<std::string>& lines, std::vector<std::string>& cues) {
+    std::vector<std::string> states;
+    for (const auto& l : lines) {
+      const std::string st = field(l, "traversal") + " step " + field(l, "step") + " left " + field(l, "left") +
+                             " known " + field(l, "known");
+      if (states.empty() || states.back() != st) states.push_back(st);
+      if (field(l, "cue") != "-") cues.push_back(field(l, "cue"));
+    }
+    return states;
+  };
+  std::vector<std::string> good_cues, jumped_cues;
+  EXPECT_EQ(story(jumped, jumped_cues), story(good, good_cues));
+  EXPECT_EQ(jumped_cues, good_cues);
+  int on_flight = 0, differ = 0;
+  for (std::size_t i = 0; i < good.size(); ++i) {
+    differ += jumped[i] != good[i];
+    on_flight += good[i].find(" step=0 ") == std::string::npos;
+  }
+  EXPECT_LE(differ, 4) << "frames whose decision differs from the good clock's";
+  std::printf("%d of %ld frames on a step; with the clock jumping back 5 s at frame 300 the same states, counts and "
+              "cues in the same order, %d frames' decisions one frame apart\n",
+              on_flight, frames, differ);
+  EXPECT_GT(on_flight, 100);
+  EXPECT_NE(err.find("frame 300 (#300 of the run): timestamp"), std::string::npos) << err;
+  EXPECT_NE(err.find("goes back 4.96"), std::string::npos) << err;
+  EXPECT_NE(err.find("1 of " + std::to_string(frames) + " frames had a timestamp that could not be trusted"),
+            std::string::npos)
+      << err;
 }
 
 TEST_F(DaemonE2E, CorruptOrMissingRecordingFailsWithAClearMessage) {
@@ -268,10 +419,45 @@ TEST_F(DaemonE2E, UnreadableOrInvalidConfigIsNamedAndNothingRuns) {
   EXPECT_NE(run_capture(std::string(STAIRGUIDED) + " --check-config " + bad.string(), out), 0);
   EXPECT_NE(out.find("ring_capacity"), std::string::npos) << out;
   EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --bogus", out), 2);
+  // An empty config is invalid at start too, the file named (issue 41: check-config called it valid).
+  const fs::path empty = kDir / "empty.yaml";
+  write_file(empty, "   \n# nothing yet\n");
+  EXPECT_EQ(run_capture(std::string(STAIRGUIDED) + " --check-config " + empty.string(), out), 3) << out;
+  EXPECT_NE(out.find(empty.string() + ": the config is empty"), std::string::npos) << out;
+  {
+    Daemon d({"--config", empty.string(), "--replay", oni_.string()}, io("emptyconfig"));
+    EXPECT_EQ(d.wait_exit(10.0), 3);
+    EXPECT_NE(d.stderr_text().find("the config is empty"), std::string::npos) << d.stderr_text();
+  }
+}
+
+// Issue 41: under a 250 MB address-space limit the daemon died of an uncaught std::bad_alloc (exit
+// 134, no log line). At any limit it now ends either well or with a line naming the memory and a
+// non-zero exit (5 while starting, 1 once running), never through a signal. Where it runs out
+// depends on the machine (before the first log line at 256000 kB here, in OpenCV at 270000 kB).
+TEST(DaemonMemory, UnderATightAddressSpaceLimitItSaysOutOfMemoryAndExitsNonZero) {
+  // (Below about 250000 kB the dynamic loader itself cannot map the libraries: exit 127, before
+  // any of the daemon's code runs.)
+  for (const int kb : {256000, 270000, 300000}) {
+    std::string out;
+    const int rc = run_capture("ulimit -v " + std::to_string(kb) + "; exec " + std::string(STAIRGUIDED) +
+                                   " --replay synth:climb_3_steps:5 --fast --sync --no-frame-lines",
+                               out);
+    std::printf("ulimit -v %d: exit %d\n", kb, rc);
+    EXPECT_EQ(out.find("terminate called"), std::string::npos) << kb << ": " << out;
+    if (rc == 0) {
+      EXPECT_NE(out.find("summary frames=5"), std::string::npos) << kb << ": " << out;
+      continue;
+    }
+    EXPECT_TRUE(rc == 1 || rc == 5) << kb << ": exit " << rc << "\n" << out;
+    EXPECT_TRUE(out.find("out of memory") != std::string::npos ||
+                out.find("Insufficient memory") != std::string::npos)
+        << kb << ": " << out;
+  }
 }
 
 // The unit as installed points at the installed binary; verify it with the built one in its place.
-TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost2_5) {
+TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost0_8) {
   std::string out;
   if (run_capture("command -v systemd-analyze", out) != 0) GTEST_SKIP() << "systemd-analyze not installed";
   fs::create_directories(kDir);
@@ -290,12 +476,15 @@ TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost2_5) {
   ASSERT_TRUE(
       std::regex_search(out, m, std::regex("Overall exposure level for stairguide.service: ([0-9.]+)")))
       << out;
-  EXPECT_LE(std::stod(m[1]), 2.5) << out;
+  // 0.8 as the unit stands (issue 41: it was 1.0 while the README said 0.8; PrivateMounts=yes took
+  // it there). What is left is what the daemon needs: the devices, their groups, the buzzer's
+  // real-time priority (sched_setscheduler, from @resources), AF_UNIX and AF_NETLINK.
+  EXPECT_LE(std::stod(m[1]), 0.8) << out;
 
   // What the daemon relies on is in the unit.
   for (const char* key : {"Type=notify", "WatchdogSec=", "User=stairguide", "ExecReload=",
                           "DevicePolicy=closed", "DeviceAllow=char-usb_device rw", "DeviceAllow=char-alsa rw",
-                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio"})
+                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio", "PrivateMounts=yes"})
     EXPECT_NE(unit.find(key), std::string::npos) << key;
 }
 

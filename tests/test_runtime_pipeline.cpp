@@ -14,8 +14,18 @@
 #include <thread>
 #include <vector>
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <functional>
+#include <limits>
+#include <new>
+#include <system_error>
+
+#include "stairguide/runtime/frame_clock.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/logging.hpp"
+#include "stairguide/runtime/pipeline.hpp"
 #include "stairguide/runtime/runtime.hpp"
 
 using namespace stairguide;
@@ -34,6 +44,9 @@ class FloorSource : public FrameSource {
     bool live = false;
     long error_at = -1;    ///< replay: kError at this frame
     long timeout_at = -1;  ///< live: kTimeout from this frame on
+    std::function<double(long)> ts;     ///< the frame's timestamp (empty: i / fps)
+    std::function<void(long)> on_read;  ///< called before frame i is read
+    long bad_alloc_at = -1;             ///< std::bad_alloc from read() at this frame
   };
   explicit FloorSource(Behaviour b, long start_index = 0) : b_(b), i_(start_index) {
     k_.width = 160;
@@ -48,6 +61,8 @@ class FloorSource : public FrameSource {
       return {ReadStatus::kTimeout, "fake camera: no frame"};
     }
     if (!b_.live && i_ >= b_.frames) return {ReadStatus::kEnd, ""};
+    if (b_.on_read) b_.on_read(i_);
+    if (i_ == b_.bad_alloc_at) throw std::bad_alloc();
     if (i_ == b_.error_at)
       return {ReadStatus::kError, "fake.oni: frame " + std::to_string(i_) + " is corrupt"};
     render(out, i_);
@@ -67,7 +82,7 @@ class FloorSource : public FrameSource {
     const float fy_ = -std::sin(tilt), fz = std::cos(tilt);            // forward, camera frame
     const float walked = static_cast<float>(i) / static_cast<float>(b_.fps);
     f.index = static_cast<std::uint64_t>(i);
-    f.timestamp = static_cast<double>(i) / b_.fps;
+    f.timestamp = b_.ts ? b_.ts(i) : static_cast<double>(i) / b_.fps;
     f.intrinsics = k_;
     f.depth.create(k_.height, k_.width, CV_32FC1);
     f.gray.create(k_.height, k_.width, CV_8UC1);
@@ -426,4 +441,282 @@ TEST(Runtime, ManhattanFrameIsCarriedByTheOdometryThroughAFastTurn) {
     EXPECT_GE(seen, sync ? 5 : 1) << (sync ? "one thread" : "threaded");
     EXPECT_GE(carried, sync ? 50 : 1) << (sync ? "one thread" : "threaded");
   }
+}
+
+// ---- issue 41 ----
+
+namespace {
+
+/// What the daemon logs while alive, for the assertions on its warnings.
+struct LogCapture {
+  std::ostringstream os;
+  std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(os);
+  LogCapture() { spdlog::default_logger()->sinks().push_back(sink); }
+  ~LogCapture() {
+    auto& v = spdlog::default_logger()->sinks();
+    v.erase(std::remove(v.begin(), v.end(), sink), v.end());
+  }
+  std::string text() {
+    spdlog::default_logger()->flush();
+    return os.str();
+  }
+};
+
+/// The decisions of a run's frame lines: every field but the times measured on the machine (and
+/// `ts`, compared apart).
+std::vector<std::string> decisions(const std::vector<std::map<std::string, std::string>>& lines) {
+  std::vector<std::string> out;
+  for (auto kv : lines) {
+    for (const char* k : {"ts", "latency_ms", "odom_ms", "perception_ms"}) kv.erase(k);
+    std::string l;
+    for (const auto& [k, v] : kv) l += k + "=" + v + " ";
+    out.push_back(l);
+  }
+  return out;
+}
+
+std::vector<std::map<std::string, std::string>> run_sync(FloorSource::Behaviour b, const PipelineConfig& c,
+                                                         Runtime** rt_out = nullptr) {
+  Lines lines;
+  Runtime rt(c, replay_options(b, false, true, lines.f), nullptr);
+  if (rt_out) *rt_out = &rt;
+  rt.start();
+  EXPECT_EQ(rt.run(), 0);
+  if (rt_out) *rt_out = nullptr;
+  return lines.parse();
+}
+
+}  // namespace
+
+// 50 reloads of an unchanged config in a second, just before a flight, delayed "first step" by 25
+// frames: each restarted the odometry's track and perception's memory. A reload of the same config
+// now changes nothing: the run's decisions are those of a run without reloads, frame for frame.
+TEST(Runtime, ABurstOfReloadsOfTheSameConfigChangesNothing) {
+  FloorSource::Behaviour b;
+  b.frames = 80;
+  const PipelineConfig c = quiet_config();
+  const auto clean = run_sync(b, c);
+  Runtime* rt = nullptr;
+  int reloads = 0, applied = 0;
+  b.on_read = [&](long i) {
+    if (i < 20 || i >= 45 || !rt) return;
+    for (int k = 0; k < 2; ++k, ++reloads) applied += rt->reconfigure(c);  // 2 per frame: 50 in all
+  };
+  const auto stormed = run_sync(b, c, &rt);
+  EXPECT_EQ(reloads, 50);
+  EXPECT_EQ(applied, 0) << "an unchanged config was applied";
+  ASSERT_EQ(stormed.size(), clean.size());
+  const auto a = decisions(clean), d = decisions(stormed);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(d[i], a[i]) << "frame " << i;
+  // A changed config is still applied (generation 2 from the frame after it).
+  PipelineConfig changed = c;
+  changed.segmentation.voxel_size = 0.05f;
+  b.on_read = [&](long i) {
+    if (i == 30 && rt) applied += rt->reconfigure(changed);
+  };
+  const auto reloaded = run_sync(b, c, &rt);
+  EXPECT_EQ(applied, 1);
+  ASSERT_EQ(reloaded.size(), 80u);
+  EXPECT_EQ(reloaded[29].at("cfg"), "1");
+  EXPECT_EQ(reloaded[31].at("cfg"), "2");
+}
+
+// A reload that changes only what the odometry does not read keeps its track: the step count
+// holds its staircase in the odometry's world.
+TEST(Runtime, AReloadOfAnotherSectionDoesNotRestartTheOdometry) {
+  PipelineConfig c = quiet_config();
+  OdometryStage odometry(c);
+  PipelineConfig louder = c;
+  louder.runtime.log_level = "info";
+  louder.feedback.verbosity = "verbose";
+  louder.segmentation.voxel_size = 0.05f;
+  EXPECT_FALSE(odometry.reconfigure(louder));
+  louder.odometry.iterations += 1;
+  EXPECT_TRUE(odometry.reconfigure(louder));
+}
+
+TEST(FrameClock, UntrustworthyTimestampsAreReplacedByAMonotoneClock) {
+  FrameClock k(0.1);
+  EXPECT_EQ(k.next(5.0).t, 5.0);
+  EXPECT_EQ(k.next(5.1).t, 5.1);
+  FrameTime t = k.next(0.2);  // the clock jumps back 4.9 s
+  EXPECT_TRUE(t.replaced);
+  EXPECT_NEAR(t.t, 5.2, 1e-12);
+  EXPECT_NE(t.why.find("goes back 4.900 s"), std::string::npos) << t.why;
+  t = k.next(0.3);  // the frames after it keep their spacing from there
+  EXPECT_FALSE(t.replaced);
+  EXPECT_NEAR(t.t, 5.3, 1e-12);
+  t = k.next(0.3);
+  EXPECT_TRUE(t.replaced);
+  EXPECT_NE(t.why.find("equals the previous frame's"), std::string::npos) << t.why;
+  EXPECT_NEAR(t.t, 5.4, 1e-12);
+  for (double bad : {1e300, std::nan(""), -std::numeric_limits<double>::infinity()}) {
+    const double before = t.t;
+    t = k.next(bad);
+    EXPECT_TRUE(t.replaced) << bad;
+    EXPECT_NEAR(t.t, before + 0.1, 1e-12) << bad;
+  }
+  t = k.next(0.7);  // 0.4 s after the last usable time (three frames had none)
+  EXPECT_FALSE(t.replaced);
+  EXPECT_NEAR(t.t, 5.7 + 0.1, 1e-9);
+  t = k.next(100.0);  // a leap forward beyond the bound
+  EXPECT_TRUE(t.replaced);
+  EXPECT_NE(t.why.find("jumps 99.300 s forward"), std::string::npos) << t.why;
+  // A live camera that really stalled 5 s is believed: the wall clock says so too.
+  t = k.next(105.0, 5.02);
+  EXPECT_FALSE(t.replaced) << t.why;
+  t = k.next(104.0, 0.033);  // a live clock that jumps back: the wall-clock step is used
+  EXPECT_TRUE(t.replaced);
+  EXPECT_EQ(k.replaced(), 7u);
+}
+
+// Frame timestamps that cannot be trusted (issue 41: a clock that jumps back 5 s counted 6 of 8
+// steps, equal ones failed the odometry on 288 of 450 frames, 1e300 silenced the cues; all with exit
+// 0 and no warning). Each is replaced by the frame clock with a warning naming the frame, and the
+// run's decisions are those of the same frames with a good clock.
+TEST(Runtime, UntrustworthyTimestampsAreWarnedAndTheRunIsThatOfAGoodClock) {
+  FloorSource::Behaviour b;
+  b.frames = 60;
+  const PipelineConfig c = quiet_config();
+  const auto clean = decisions(run_sync(b, c));
+  struct Case {
+    const char* name;
+    std::function<double(long)> ts;
+    std::uint64_t replaced;
+    const char* warning;
+  };
+  const Case cases[] = {
+      {"jumps back 5 s", [](long i) { return i / 30.0 - (i >= 30 ? 5.0 : 0.0); }, 1,
+       "frame 30 (#30 of the run): timestamp -4 goes back 4.967 s"},
+      {"equal", [](long) { return 12.5; }, 59, "frame 1 (#1 of the run): timestamp 12.5 equals the previous frame's"},
+      {"reversed", [](long i) { return 100.0 - i / 30.0; }, 59, "frame 1 (#1 of the run): timestamp"},
+      {"1e300", [](long i) { return i == 30 ? 1e300 : i / 30.0; }, 1,
+       "frame 30 (#30 of the run): timestamp 1e+300 is not a time"},
+      {"NaN from frame 30", [](long i) { return i >= 30 ? std::nan("") : i / 30.0; }, 30,
+       "frame 30 (#30 of the run): timestamp nan is not a finite number"},
+  };
+  for (const Case& k : cases) {
+    LogCapture log;
+    b.ts = k.ts;
+    Lines lines;
+    Runtime rt(c, replay_options(b, false, true, lines.f), nullptr);
+    rt.start();
+    EXPECT_EQ(rt.run(), 0) << k.name;
+    const auto l = lines.parse();
+    ASSERT_EQ(l.size(), 60u) << k.name;
+    for (std::size_t i = 1; i < l.size(); ++i) {
+      const double dt = std::stod(l[i].at("ts")) - std::stod(l[i - 1].at("ts"));
+      EXPECT_GT(dt, 0.0) << k.name << " frame " << i;
+      EXPECT_LE(dt, 1.0 / 30.0 + 2e-6) << k.name << " frame " << i;
+    }
+    EXPECT_EQ(rt.stats().timestamps_replaced, k.replaced) << k.name;
+    EXPECT_EQ(decisions(l), clean) << k.name;
+    const std::string text = log.text();
+    EXPECT_NE(text.find(k.warning), std::string::npos) << k.name << ":\n" << text;
+    EXPECT_NE(text.find("frames had a timestamp that could not be trusted"), std::string::npos) << text;
+  }
+}
+
+// A live camera's clock that jumps back (a USB reset) is replaced by the wall-clock step.
+TEST(Runtime, ALiveCameraWhoseClockJumpsBackKeepsAMonotoneTime) {
+  Lines lines;
+  RuntimeOptions o;
+  o.input = "device";
+  o.synchronous = true;
+  o.max_frames = 30;
+  o.frame_lines = true;
+  o.frame_out = lines.f;
+  o.open_source = [](const std::string&, const CaptureConfig&) -> std::unique_ptr<FrameSource> {
+    FloorSource::Behaviour b;
+    b.live = true;
+    b.ts = [](long i) { return 1000.0 + i / 30.0 - (i >= 15 ? 600.0 : 0.0); };
+    return std::make_unique<FloorSource>(b);
+  };
+  LogCapture log;
+  Runtime rt(quiet_config(), o, nullptr);
+  rt.start();
+  EXPECT_EQ(rt.run(), 0);
+  const auto l = lines.parse();
+  ASSERT_EQ(l.size(), 30u);
+  for (std::size_t i = 1; i < l.size(); ++i) EXPECT_GT(std::stod(l[i].at("ts")), std::stod(l[i - 1].at("ts")));
+  EXPECT_EQ(rt.stats().timestamps_replaced, 1u);
+  EXPECT_NE(log.text().find("frame 15 (#15 of the run): timestamp 400.5 goes back"), std::string::npos)
+      << log.text();
+}
+
+// A thread that cannot be started is named as such; it read "cannot open input".
+TEST(Runtime, AThreadThatCannotStartIsNamedAndIsNotTheInput) {
+  FloorSource::Behaviour b;
+  b.frames = 100000;
+  RuntimeOptions o = replay_options(b, true, false, nullptr);
+  o.start_thread = [](const char* name, std::function<void()> body) {
+    if (std::string(name) == "perception") throw std::system_error(EAGAIN, std::generic_category(), "pthread_create");
+    return std::thread(std::move(body));
+  };
+  Runtime rt(quiet_config(), o, nullptr);
+  try {
+    rt.start();
+    FAIL() << "started without its perception thread";
+  } catch (const SourceError& e) {
+    FAIL() << "a thread that cannot start reads as the input's fault: " << e.what();
+  } catch (const StartError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot start the perception thread: pthread_create: Resource temporarily "
+                                         "unavailable"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(rt.join(std::chrono::milliseconds(2000))) << "the threads already started stop";
+}
+
+// Out of memory in a thread (`ulimit -v 256000`) ended the daemon through std::terminate with no
+// log line. It is logged, the run fails (exit code 1) and the other threads stop.
+TEST(Runtime, OutOfMemoryInAThreadIsLoggedAndFailsTheRun) {
+  for (const bool sync : {false, true}) {
+    LogCapture log;
+    FloorSource::Behaviour b;
+    b.frames = 100;
+    b.bad_alloc_at = 10;
+    Runtime rt(quiet_config(), replay_options(b, false, sync, nullptr), nullptr);
+    rt.start();
+    if (sync) {
+      EXPECT_EQ(rt.run(), 1);
+    } else {
+      ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(30)));
+      ASSERT_TRUE(rt.join(std::chrono::seconds(2)));
+    }
+    EXPECT_EQ(rt.exit_code(), 1);
+    EXPECT_EQ(rt.stats().state, "failed");
+    const std::string text = log.text();
+    EXPECT_NE(text.find(std::string(sync ? "pipeline (one thread)" : "capture") +
+                        " thread failed: out of memory (std::bad_alloc)"),
+              std::string::npos)
+        << text;
+  }
+}
+
+// A configuration the ranges allowed hid a 20 s lag (ring_capacity 1024, a slow odometry) while the
+// status said latency 4.8 ms. Perception takes the newest frame, so its latency stays small; the age
+// of the odometry's poses is measured and reported apart. In a replay as fast as the odometry goes,
+// the frame ring stays full: each pose comes about a ringful of odometry steps after its capture.
+TEST(Runtime, AnOdometryBehindTheCameraShowsInTheStatus) {
+  FloorSource::Behaviour b;
+  b.frames = 150;
+  PipelineConfig c = quiet_config();
+  c.runtime.ring_capacity = 1024;  // not loadable any more; held to 30 in code too
+  c.runtime.status_interval = 0.1f;
+  RecordingNotifier n;
+  Runtime rt(c, replay_options(b, false, false, nullptr), &n);
+  rt.start();
+  ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(120)));
+  ASSERT_TRUE(rt.join(std::chrono::seconds(2)));
+  const RuntimeStats s = rt.stats();
+  std::printf("odometry %.2f ms a frame, its poses p50 %.1f ms p99 %.1f ms max %.1f ms after capture; "
+              "perception latency p50 %.1f ms\n",
+              s.odometry_ms_mean, s.odometry_lag_p50_ms, s.odometry_lag_p99_ms, s.odometry_lag_max_ms,
+              s.latency_p50_ms);
+  EXPECT_GT(s.odometry_lag_p50_ms, 5.0 * s.odometry_ms_mean) << "the ring's wait shows";
+  // At most a ringful (32 frames) waits before the odometry: 1024 held 20 s of them.
+  EXPECT_LT(s.odometry_lag_max_ms, 60.0 * std::max(1.0, s.odometry_ms_mean) + 1000.0);
+  EXPECT_GE(n.count("odometry lag p50"), 1);
+  EXPECT_NE(s.summary().find("odometry lag p50"), std::string::npos) << s.summary();
 }

@@ -1,8 +1,9 @@
 // stairguided: the daemon. A thin main over stairguide::runtime: arguments, config, logging,
 // signals (SIGTERM/SIGINT stop, SIGHUP reloads the config) and the exit code.
 //
-// Exit codes: 0 clean stop or end of replay, 1 a replay failed mid-way, 2 bad arguments,
-// 3 config error, 4 the replay input cannot be opened.
+// Exit codes: 0 clean stop or end of replay, 1 a replay failed mid-way or a thread failed (out of
+// memory: logged), 2 bad arguments, 3 config error, 4 the replay input cannot be opened, 5 the
+// daemon could not start (out of threads or memory).
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -135,9 +136,44 @@ void block_stop_signals(int, char**, char**) {
 __attribute__((section(".preinit_array"),
                used)) void (*const block_stop_signals_early)(int, char**, char**) = block_stop_signals;
 
+/// The last word when memory ran out outside the runtime's threads (they log their own): a
+/// message that needs no allocation when even logging cannot have any.
+void say_out_of_memory(const char* where) noexcept {
+  try {
+    spdlog::critical("out of memory (std::bad_alloc) {}: the memory limit (ulimit -v, the unit's MemoryMax=) "
+                     "is too small for the daemon; exiting",
+                     where);
+    spdlog::default_logger()->flush();
+  } catch (...) {
+    static const char msg[] = "stairguided: out of memory (std::bad_alloc); exiting\n";
+    [[maybe_unused]] const auto n = ::write(2, msg, sizeof msg - 1);
+  }
+}
+
+int daemon_main(int argc, char** argv);
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // An exception escaping main (out of memory under a tight limit) ended the process through
+  // std::terminate with no log line (issue 41): it is named here and the exit is 5.
+  try {
+    return daemon_main(argc, argv);
+  } catch (const std::bad_alloc&) {
+    say_out_of_memory("while starting or stopping");
+  } catch (const std::exception& e) {
+    try {
+      spdlog::critical("stopping on an unexpected error: {}", e.what());
+      spdlog::default_logger()->flush();
+    } catch (...) {
+    }
+  }
+  return 5;
+}
+
+namespace {
+
+int daemon_main(int argc, char** argv) {
   // Signals are taken synchronously by one thread (sigtimedwait), never by a handler. Blocked
   // first thing, so a SIGHUP or SIGTERM during start-up waits instead of killing the process;
   // every thread started later inherits the mask.
@@ -197,10 +233,19 @@ int main(int argc, char** argv) {
   runtime::Runtime rt(config, opt, &notifier);
   try {
     rt.start();
-  } catch (const std::exception& e) {
+  } catch (const SourceError& e) {
     spdlog::critical("cannot open input: {}", e.what());
     notifier.notify(std::string("STATUS=cannot open input: ") + e.what());
     return 4;
+  } catch (const std::bad_alloc&) {
+    say_out_of_memory("while starting the pipeline");
+    notifier.notify("STATUS=cannot start: out of memory");
+    return 5;
+  } catch (const std::exception& e) {
+    // A thread that cannot be had (StartError) or any other failure to start: not the input's.
+    spdlog::critical("cannot start: {}", e.what());
+    notifier.notify(std::string("STATUS=cannot start: ") + e.what());
+    return 5;
   }
 
   std::atomic<bool> stop_requested{false};
@@ -223,10 +268,13 @@ int main(int argc, char** argv) {
         try {
           PipelineConfig fresh = load_config(args.config_path);
           apply_overrides(args, fresh);
-          rt.reconfigure(fresh);
-          spdlog::info("SIGHUP: config reloaded from {} (generation {})", args.config_path,
-                       rt.stats().config_generation);
-          notifier.notify("STATUS=config reloaded");
+          if (rt.reconfigure(fresh)) {
+            spdlog::info("SIGHUP: config reloaded from {} (generation {})", args.config_path,
+                         rt.stats().config_generation);
+            notifier.notify("STATUS=config reloaded");
+          } else {
+            spdlog::info("SIGHUP: {} unchanged; the running config and its state are kept", args.config_path);
+          }
         } catch (const std::exception& e) {
           spdlog::error("SIGHUP: config reload rejected, keeping the running config: {}", e.what());
           notifier.notify(std::string("STATUS=config reload rejected: ") + e.what());
@@ -251,12 +299,14 @@ int main(int argc, char** argv) {
   const runtime::RuntimeStats st = rt.stats();
   spdlog::info("{}", st.summary());
   notifier.notify("STATUS=" + st.summary());
-  if (replay && args.frame_lines) {
+  // The summary line comes with or without the frame lines (--no-frame-lines leaves those out).
+  if (replay) {
     std::printf(
         "summary frames=%llu odometry_frames=%llu odometry_lost=%llu perception_frames=%llu "
         "perception_skipped=%llu fps=%.2f latency_p50_ms=%.2f latency_p99_ms=%.2f state=%s traversal=%s "
         "traversal_step=%d traversal_left=%d traversal_known=%d cues=%llu cues_sounded=%llu "
-        "cue_latency_p50_ms=%.2f cue_latency_p99_ms=%.2f last_cue=%s\n",
+        "cue_latency_p50_ms=%.2f cue_latency_p99_ms=%.2f last_cue=%s cues_lost=%llu odometry_lag_p99_ms=%.2f "
+        "timestamps_replaced=%llu\n",
         static_cast<unsigned long long>(st.frames_captured),
         static_cast<unsigned long long>(st.odometry_frames),
         static_cast<unsigned long long>(st.odometry_frames_lost),
@@ -264,7 +314,9 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(st.perception_skipped), st.fps, st.latency_p50_ms, st.latency_p99_ms,
         st.state.c_str(), st.traversal_state.c_str(), st.traversal_step, st.traversal_left, st.traversal_known,
         static_cast<unsigned long long>(st.cues), static_cast<unsigned long long>(st.cues_sounded),
-        st.cue_latency_p50_ms, st.cue_latency_p99_ms, st.last_cue.empty() ? "-" : st.last_cue.c_str());
+        st.cue_latency_p50_ms, st.cue_latency_p99_ms, st.last_cue.empty() ? "-" : st.last_cue.c_str(),
+        static_cast<unsigned long long>(st.cues_lost), st.odometry_lag_p99_ms,
+        static_cast<unsigned long long>(st.timestamps_replaced));
   }
   std::fflush(stdout);
   spdlog::default_logger()->flush();
@@ -277,3 +329,4 @@ int main(int argc, char** argv) {
   }
   return code;
 }
+}  // namespace

@@ -5,7 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+
+#include "stairguide/capture/frame_source.hpp"
 
 namespace stairguide {
 
@@ -77,6 +85,38 @@ cv::Mat depth_to_u16(const cv::Mat& depth_m, double scale) {
     }
   }
   return out;
+}
+
+std::string errno_words(int err) {
+  switch (err) {
+    case ENOENT:
+      return "no such file";
+    case EACCES:
+    case EPERM:
+      return "permission denied";
+    case ELOOP:
+      return "a symbolic link loop (too many levels of symbolic links)";
+    case ENOTDIR:
+      return "not a directory (a component of the path)";
+    case ENAMETOOLONG:
+      return "file name too long";
+    default:
+      return std::strerror(err);
+  }
+}
+
+std::string why_unreadable(const std::string& path, bool directory) {
+  if (path.empty()) return "no file name given";
+  // Opened, not stat'ed or access()'ed: what the reader will meet (an unreadable file can be
+  // stat'ed; root passes access() where a mount refuses). O_NONBLOCK: a FIFO does not wait here.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) return errno_words(errno);
+  ::close(fd);
+  return "";
+}
+
+std::string unreadable_words(const std::string& why, const std::string& what) {
+  return why == "no such file" ? "missing (no such file)" : "cannot read " + what + " (" + why + ")";
 }
 
 std::string lower_extension(const std::string& path) {

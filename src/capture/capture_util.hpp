@@ -18,6 +18,9 @@ std::string fmt_num(double v);
 std::string describe_mat_type(const cv::Mat& m);
 /// Metres (CV_32FC1, 0 = none) to CV_16UC1 units: round(d * scale); NaN, <= 0 and > 65535 units -> 0.
 cv::Mat depth_to_u16(const cv::Mat& depth_m, double scale);
+/// "missing (no such file)" when `why` (why_unreadable) says so, else "cannot read WHAT (why)":
+/// the words for a file that could not be opened, its cause named.
+std::string unreadable_words(const std::string& why, const std::string& what);
 /// Lower-case file extension with the dot (".oni"), "" when none.
 std::string lower_extension(const std::string& path);
 /// A labels.yaml (per-frame or whole-folder) read strictly (strict_yaml.hpp: one document, no key

@@ -26,8 +26,9 @@ namespace stairguide {
 
 DatasetCamera read_camera_yaml(const std::string& path) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw SourceError(path + ": " + (fs::exists(path, ec) ? "not a regular file" : "missing (no such file)"));
+  if (const std::string why = why_unreadable(path); !why.empty())
+    throw SourceError(path + ": " + unreadable_words(why, "it"));
+  if (!fs::is_regular_file(path, ec)) throw SourceError(path + ": not a regular file");
   YAML::Node root;
   try {
     // Seven numbers and comments: 64 KiB and 1000 nodes are far more than one holds.
@@ -175,7 +176,11 @@ std::vector<TimedPose> read_groundtruth(const std::string& path) {
 
 DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& options) : dir_(dir) {
   std::error_code ec;
-  if (!fs::exists(dir, ec)) throw SourceError("dataset " + dir + ": folder missing (no such directory)");
+  if (const std::string why = why_unreadable(dir, true); !why.empty()) {
+    if (why == "no such file") throw SourceError("dataset " + dir + ": folder missing (no such directory)");
+    if (!(fs::exists(dir, ec) && !fs::is_directory(dir, ec)))  // else: a file, said below
+      throw SourceError("dataset " + dir + ": cannot read the folder (" + why + ")");
+  }
   if (!fs::is_directory(dir, ec)) throw SourceError("dataset " + dir + ": not a directory");
   const fs::path d(dir);
   camera_ = read_camera_yaml((d / "camera.yaml").string());
@@ -190,21 +195,48 @@ DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& optio
   if (has_rgb) {
     rgb = read_list(rgb_txt);
     if (rgb.empty()) throw SourceError(rgb_txt + ": lists no colour images");
-    std::stable_sort(rgb.begin(), rgb.end(),
-                     [](const ListEntry& a, const ListEntry& b) { return a.t < b.t; });
   }
+  // A clock that jumps back (or any list whose times do not grow) makes a time ambiguous: after a
+  // 5 s jump back, frame 300's time is frame 150's, and nearest-time pairing gave it frame 150's
+  // colour (issue 41). Such lists are paired in file order: each depth image with the nearest of
+  // the next few colour images after the previous pair's. Lists in time order pair as before.
+  // Equal times count as out of order too: every depth image took the first colour image of the time.
+  auto in_order = [](const std::vector<ListEntry>& l) {
+    return std::adjacent_find(l.begin(), l.end(),
+                              [](const ListEntry& a, const ListEntry& b) { return !(b.t > a.t); }) == l.end();
+  };
+  const bool file_order = has_rgb && !(in_order(depth) && in_order(rgb));
+  std::size_t prev_rgb = 0;
+  bool have_prev = false;
+  if (has_rgb && !file_order)
+    std::stable_sort(rgb.begin(), rgb.end(), [](const ListEntry& a, const ListEntry& b) { return a.t < b.t; });
   for (const auto& e : depth) {
     Pair p;
     p.t_depth = e.t;
     p.depth_path = (d / e.path).string();
     if (has_rgb) {
-      // Nearest colour timestamp by binary search.
-      auto it =
-          std::lower_bound(rgb.begin(), rgb.end(), e.t, [](const ListEntry& a, double t) { return a.t < t; });
       const ListEntry* best = nullptr;
-      if (it != rgb.end()) best = &*it;
-      if (it != rgb.begin() && (!best || std::abs((it - 1)->t - e.t) <= std::abs(best->t - e.t)))
-        best = &*(it - 1);
+      if (file_order) {
+        // The next few after the previous pair's (the earliest of equally near ones), or that one
+        // again when it is nearer still (a colour camera slower than the depth camera).
+        constexpr std::size_t kWindow = 8;
+        const std::size_t start = have_prev ? prev_rgb + 1 : 0;
+        for (std::size_t j = start; j < rgb.size() && j < start + kWindow; ++j)
+          if (!best || std::abs(rgb[j].t - e.t) < std::abs(best->t - e.t)) best = &rgb[j];
+        if (have_prev && (!best || std::abs(rgb[prev_rgb].t - e.t) < std::abs(best->t - e.t)))
+          best = &rgb[prev_rgb];
+        if (best && std::abs(best->t - e.t) <= options.max_pair_dt) {
+          prev_rgb = static_cast<std::size_t>(best - rgb.data());
+          have_prev = true;
+        }
+      } else {
+        // Nearest colour timestamp by binary search.
+        auto it =
+            std::lower_bound(rgb.begin(), rgb.end(), e.t, [](const ListEntry& a, double t) { return a.t < t; });
+        if (it != rgb.end()) best = &*it;
+        if (it != rgb.begin() && (!best || std::abs((it - 1)->t - e.t) <= std::abs(best->t - e.t)))
+          best = &*(it - 1);
+      }
       if (!best || std::abs(best->t - e.t) > options.max_pair_dt) {
         ++skipped_;
         continue;
@@ -248,7 +280,9 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
     return ReadResult{ReadStatus::kError, file + ": " + why};
   };
   // Existence first: imread cannot tell a missing file from a corrupt one.
-  if (!fs::exists(p.depth_path, ec)) return fail(p.depth_path, "depth image missing");
+  // And readable: an unreadable image read as "corrupt" (issue 41).
+  if (const std::string why = why_unreadable(p.depth_path); !why.empty())
+    return fail(p.depth_path, why == "no such file" ? "depth image missing" : "cannot read depth image (" + why + ")");
   cv::Mat raw = cv::imread(p.depth_path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) return fail(p.depth_path, "cannot decode depth image (corrupt or not an image)");
   if (raw.type() != CV_16UC1)
@@ -260,7 +294,9 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
                                   std::to_string(k.height));
   raw.convertTo(out.depth, CV_32F, 1.0 / camera_.depth_scale);
   if (!p.color_path.empty()) {
-    if (!fs::exists(p.color_path, ec)) return fail(p.color_path, "colour image missing");
+    if (const std::string why = why_unreadable(p.color_path); !why.empty())
+      return fail(p.color_path,
+                  why == "no such file" ? "colour image missing" : "cannot read colour image (" + why + ")");
     cv::Mat c = cv::imread(p.color_path, cv::IMREAD_COLOR);
     if (c.empty()) return fail(p.color_path, "cannot decode colour image (corrupt or not an image)");
     if (c.cols != k.width || c.rows != k.height)

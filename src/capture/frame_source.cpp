@@ -109,7 +109,10 @@ std::unique_ptr<FrameSource> open_ungated(const std::string& input, const Captur
   if (ext == ".pcd") return std::make_unique<SingleFrameSource>(read_pcd_frame(input), "pcd " + input);
   if (ext == ".png")
     return std::make_unique<SingleFrameSource>(read_depth_png_frame(input), "depth image " + input);
-  if (!fs::exists(input, ec)) throw SourceError("input '" + input + "': no such file or directory");
+  // The cause, as the system gives it: a symlink loop or a folder the user may not enter read
+  // "no such file" (issue 41).
+  if (const std::string why = why_unreadable(input); !why.empty())
+    throw SourceError("input '" + input + "': cannot open it (" + why + ")");
   throw SourceError("input '" + input +
                     "': unknown kind (expected a dataset folder, FILE.oni, FILE.pcd, FILE.png, device[:URI] "
                     "or synth:SCENE[:FRAMES[:SEED[:NOISE]]])");

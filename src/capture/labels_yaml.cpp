@@ -188,8 +188,9 @@ std::string labels_to_yaml(const std::vector<FrameTruth>& frames) {
 
 YAML::Node load_labels_file(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw SourceError(path + ": missing or not a regular file");
+  if (const std::string why = why_unreadable(path); !why.empty())
+    throw SourceError(path + ": " + unreadable_words(why, "it"));
+  if (!std::filesystem::is_regular_file(path, ec)) throw SourceError(path + ": not a regular file");
   try {
     // A labelled frame is about 1.2 kB and 130 nodes: these bounds are some 15000 frames with a
     // staircase each, and keep yaml-cpp's tree (a few hundred bytes a node) under a gigabyte.

@@ -48,7 +48,7 @@ void check_oni_records(const std::string& path, std::uintmax_t size) {
                        why + ")");
   };
   std::uintmax_t pos = 24;
-  std::set<std::uint32_t> cropped;  // streams (node ids) with their xnCropping property
+  std::set<std::uint32_t> cropped;  // streams (node ids) whose xnCropping property has come
   while (size - pos >= 28) {
     in.seekg(static_cast<std::streamoff>(pos));
     if (!in.read(reinterpret_cast<char*>(h), 28)) return;
@@ -84,9 +84,14 @@ void check_oni_records(const std::string& path, std::uintmax_t size) {
       }
     }
     // A stream the player serves without its cropping state crashed it once its frames came
-    // (fuzz_oni); OpenNI2's Recorder and OniWriter always write one before the stream is ready.
-    if (type == 0x09 && !cropped.count(le32(h + 8)))
-      throw bad(pos, "stream " + std::to_string(le32(h + 8)) + " has no xnCropping property");
+    // (fuzz_oni), and OpenNI2 2.2's player drops every frame of such a stream (checked): the
+    // property must come before the stream's first frame. Only there: it may come after the
+    // stream is ready (OpenNI2's player reads such a recording; refusing it at the ready record
+    // refused a real Kinect recording, issue 41), and a stream with no frames needs none.
+    if (type == 0x0A && !cropped.count(le32(h + 8)))
+      throw bad(pos, "stream " + std::to_string(le32(h + 8)) +
+                         " carries frames but has no xnCropping property before them (OpenNI2's player would "
+                         "drop them all)");
     pos += static_cast<std::uintmax_t>(fields) + payload;
     if (type == 0x0B) return;  // End
   }
@@ -151,7 +156,10 @@ OniSource::OniSource(const std::string& path, const OniOptions& options) : impl_
   m.options = options;
   // OpenNI gives the same status for a missing, corrupt or directory path: check first.
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw SourceError("oni " + path + ": recording missing (no such file)");
+  if (const std::string why = why_unreadable(path); !why.empty() && !fs::is_directory(path, ec))
+    throw SourceError("oni " + path + ": " +
+                      (why == "no such file" ? "recording missing (no such file)"
+                                             : "cannot read the recording (" + why + ")"));
   if (!fs::is_regular_file(path, ec)) throw SourceError("oni " + path + ": not a regular file");
   if (fs::file_size(path, ec) < 24)
     throw SourceError("oni " + path + ": too short to be a recording (truncated?)");

@@ -258,6 +258,13 @@ PipelineConfig load_config_text(const std::string& text, const std::string& name
   } catch (const InputFileError& e) {
     throw ConfigError(e.what());
   }
+  // A file with no keys at all (empty, blanks, comments only) is not a config that asks for the
+  // defaults: it is an editor that truncated the file before writing it, or the wrong file.
+  // Taken, it silently put every key back to its default (issue 41); an explicit `{}` still does.
+  if (doc.IsNull())
+    throw ConfigError(name +
+                      ": the config is empty (no keys: only blank lines or comments); refused. Give at least "
+                      "one section, or `{}` for every default");
   PipelineConfig c;
   Reader r(name, report);
   r.root(doc, c);

@@ -4,6 +4,7 @@
 // never waits on a device. A sink that cannot be had is logged and the other goes on.
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <mutex>
 #include <unordered_map>
 
@@ -28,8 +29,14 @@ struct FeedbackStage::Impl {
   LatencyHistogram latency;
   std::uint64_t cues = 0;
   std::string last_cue;
+  // Cues lost to a sound outage (issue 41: they left no trace). The ALSA sink drops an utterance
+  // that waited past its age limit or overflowed its queue (counted as stale); what still waits
+  // when the input has ended and drain() gave up is lost too.
+  std::uint64_t audio_given = 0, audio_started = 0, stale_seen = 0, unplayed_at_end = 0;
 
   std::unique_ptr<fb::AudioSink> audio;
+  // `audio` when it is the ALSA sink (its counters); read by cue_latency() from any thread.
+  std::atomic<fb::AlsaAudioSink*> alsa{nullptr};
   std::unique_ptr<fb::Haptic> haptic;
   bool sinks_open = false;
   std::string last_state = "none";
@@ -62,12 +69,15 @@ struct FeedbackStage::Impl {
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
       ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) {
         std::lock_guard<std::mutex> lk(lat_mutex);
+        ++audio_started;
         const auto it = pending.find(id);
         if (it == pending.end()) return;
         latency.add(std::chrono::duration<double, std::milli>(t - it->second).count());
         pending.erase(it);
       };
-      audio = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
+      auto sink = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
+      alsa = sink.get();
+      audio = std::move(sink);
     } else {
       audio = std::make_unique<fb::NullAudioSink>();
     }
@@ -106,6 +116,7 @@ struct FeedbackStage::Impl {
         pending[u.id] = captured;
         ++cues;
         last_cue = u.label;
+        if (alsa) ++audio_given;
       }
       audio->play(std::move(u));
       // One pattern per frame, the most urgent (the cues come highest priority first).
@@ -117,7 +128,25 @@ struct FeedbackStage::Impl {
         }
       }
     }
+    check_lost();
     return fb::tokens(cues_now);
+  }
+
+  /// Logs the cues the sound device dropped since the last look.
+  void check_lost() {
+    const fb::AlsaAudioSink* sink = alsa.load();
+    if (!sink) return;
+    const std::uint64_t stale = sink->counters().stale;
+    if (stale == stale_seen) return;
+    std::uint64_t lost = 0;
+    {
+      std::lock_guard<std::mutex> lk(lat_mutex);
+      lost = stale + unplayed_at_end;
+    }
+    spdlog::warn("audio: {} cue{} dropped unplayed: the sound device '{}' could not take {} in time ({} lost so far)",
+                 stale - stale_seen, stale - stale_seen == 1 ? "" : "s", config.feedback.audio_device,
+                 stale - stale_seen == 1 ? "it" : "them", lost);
+    stale_seen = stale;
   }
 };
 
@@ -131,6 +160,7 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   d.changed = d.state != impl_->last_state;
   impl_->last_state = d.state;
   impl_->last_t = timestamp_s;
+  impl_->check_lost();
   if (!perception.ran) return d;  // no perception stage: nothing to tell
   fb::CueInput in;
   in.t = timestamp_s;
@@ -187,12 +217,31 @@ std::string FeedbackStage::describe() const {
 void FeedbackStage::drain(std::chrono::milliseconds timeout) {
   if (!impl_->sinks_open) return;
   const auto until = SteadyClock::now() + timeout;
-  impl_->audio->drain(timeout);
+  const bool idle = impl_->audio->drain(timeout);
+  impl_->check_lost();
+  if (const fb::AlsaAudioSink* alsa = impl_->alsa.load(); !idle && alsa) {
+    // The input has ended: what still waits for the device will not be heard.
+    const std::uint64_t stale = alsa->counters().stale;
+    std::uint64_t waiting = 0, lost = 0;
+    {
+      std::lock_guard<std::mutex> lk(impl_->lat_mutex);
+      const std::uint64_t done = impl_->audio_started + stale + impl_->unplayed_at_end;
+      waiting = impl_->audio_given > done ? impl_->audio_given - done : 0;
+      impl_->unplayed_at_end += waiting;
+      lost = stale + impl_->unplayed_at_end;
+    }
+    if (waiting > 0)
+      spdlog::warn("audio: {} cue{} still waiting for the sound device '{}' at the end of the input, never played "
+                   "({} lost in all)",
+                   waiting, waiting == 1 ? "" : "s", impl_->config.feedback.audio_device, lost);
+  }
   const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - SteadyClock::now());
   impl_->haptic->drain(std::max(left, std::chrono::milliseconds(0)));
 }
 
 FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
+  const fb::AlsaAudioSink* alsa = impl_->alsa.load();
+  const std::uint64_t stale = alsa ? alsa->counters().stale : 0;  // before lat_mutex: never both held
   std::lock_guard<std::mutex> lk(impl_->lat_mutex);
   CueLatency c;
   c.cues = impl_->cues;
@@ -201,6 +250,7 @@ FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
   c.p99_ms = impl_->latency.percentile(99);
   c.max_ms = impl_->latency.max();
   c.last = impl_->last_cue;
+  c.lost = impl_->unplayed_at_end + stale;
   return c;
 }
 

@@ -93,14 +93,21 @@ OdometryOutput OdometryStage::step(const RgbdFrame& frame) {
   out.ms = ms_since(t0);
   return out;
 }
-void OdometryStage::reconfigure(const PipelineConfig& config) {
+bool OdometryStage::reconfigure(const PipelineConfig& config) {
   Impl& m = *impl_;
+  // Only its own section matters: a reload for the verbosity or the perception's tunables must
+  // not restart the track the step count holds its staircase in.
+  PipelineConfig probe = m.config;
+  probe.odometry = config.odometry;
+  const bool same = config_equal(probe, m.config);
   m.config = config;
+  if (same) return false;
   if (m.configured) {
     const Pose keep = m.odometry.pose();
     m.odometry.configure(config.odometry, m.intrinsics);
     m.odometry.reset(keep);
   }
+  return true;
 }
 void OdometryStage::restart() { impl_->odometry.reset(impl_->odometry.pose()); }
 bool OdometryStage::available() const { return true; }
@@ -221,6 +228,18 @@ const SceneResult& PerceptionStage::last_scene() const { return impl_->scene; }
 const StairResult& PerceptionStage::last_stair() const { return impl_->stair; }
 
 void PerceptionStage::reconfigure(const PipelineConfig& config) {
+  // Sections perception does not read (the odometry's, the runtime's, the feedback's) change
+  // nothing here: its memory (the floor, the Manhattan frame, what the stairs stage holds) stays.
+  {
+    PipelineConfig probe = config;
+    probe.odometry = impl_->config.odometry;
+    probe.runtime = impl_->config.runtime;
+    probe.feedback = impl_->config.feedback;
+    if (config_equal(probe, impl_->config)) {
+      impl_->config = config;
+      return;
+    }
+  }
   // The stages take their config at construction; tracking restarts with the new values. Not the
   // traversal: a reload on the stairs (a SIGHUP for the verbosity) would have started the count
   // again from nothing under the user's feet. The odometry keeps its world over a reload, so the

@@ -8,6 +8,7 @@
 #include "stairguide/runtime/runtime.hpp"
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -16,9 +17,12 @@
 #include <condition_variable>
 #include <deque>
 #include <mutex>
+#include <new>
+#include <system_error>
 #include <thread>
 
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/runtime/frame_clock.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/logging.hpp"
 #include "stairguide/runtime/pipeline.hpp"
@@ -116,21 +120,24 @@ enum class NextFrame { kFrame, kEnd, kError, kStopped };
 }  // namespace
 
 std::string RuntimeStats::summary() const {
-  char buf[512];
+  char buf[768];
   const double drop_pct = 100.0 * perception_drop_rate;
   std::snprintf(
       buf, sizeof buf,
       "%s: %llu frames, %.1f fps, odometry %llu (failed %llu, lost %llu), perception %llu "
-      "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, camera lost %llu, cfg %llu, "
-      "traversal %s step %d left %d known %d, cues %llu (last %s)",
+      "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, odometry lag p50 %.1f ms p99 %.1f ms, "
+      "camera lost %llu, cfg %llu, timestamps replaced %llu, traversal %s step %d left %d known %d, cues %llu "
+      "(lost %llu, last %s)",
       state.c_str(), static_cast<unsigned long long>(frames_captured), fps,
       static_cast<unsigned long long>(odometry_frames), static_cast<unsigned long long>(odometry_failures),
       static_cast<unsigned long long>(odometry_frames_lost),
       static_cast<unsigned long long>(perception_frames), perception_fps,
       static_cast<unsigned long long>(perception_skipped), drop_pct, latency_p50_ms, latency_p99_ms,
-      static_cast<unsigned long long>(camera_losses), static_cast<unsigned long long>(config_generation),
+      odometry_lag_p50_ms, odometry_lag_p99_ms, static_cast<unsigned long long>(camera_losses),
+      static_cast<unsigned long long>(config_generation), static_cast<unsigned long long>(timestamps_replaced),
       traversal_state.c_str(), traversal_step, traversal_left, traversal_known,
-      static_cast<unsigned long long>(cues), last_cue.empty() ? "-" : last_cue.c_str());
+      static_cast<unsigned long long>(cues), static_cast<unsigned long long>(cues_lost),
+      last_cue.empty() ? "-" : last_cue.c_str());
   return buf;
 }
 
@@ -190,6 +197,10 @@ struct Runtime::Impl {
   // ---- latency and times (sink thread writes, stats() reads) ----
   mutable std::mutex stats_mutex;
   LatencyHistogram latency, interval_latency;
+  // Capture -> the odometry's result reaching the feedback thread: the age of the poses the
+  // traversal works with. Perception takes the newest frame, so its latency stays small however
+  // far the odometry has fallen behind (issue 41: 20 s behind with the status saying 4.8 ms).
+  LatencyHistogram odo_lag, interval_odo_lag;
   Clock::time_point first_capture{}, last_decision{};
   bool have_first = false, have_last = false;
   TraversalResult last_traversal;  // of the last decision (stats_mutex)
@@ -220,6 +231,9 @@ struct Runtime::Impl {
   Clock::time_point pace_t0{}, last_due{};
   double backoff = 0.0;
   bool camera_reported_lost = false;
+  std::unique_ptr<FrameClock> frame_clock;  // created at the first frame (the source's nominal rate)
+  Clock::time_point last_read{};
+  std::atomic<std::uint64_t> ts_replaced{0};
 
   // ---- sink (feedback thread, or the caller in synchronous mode) ----
   std::deque<OdoMsg> odo_pending;
@@ -240,7 +254,8 @@ struct Runtime::Impl {
       };
     live = opt.input.empty() || opt.input == "device" || opt.input.rfind("device:", 0) == 0;
     if (opt.input.empty()) opt.input = "device";
-    const auto cap = static_cast<std::size_t>(std::max(2, c.runtime.ring_capacity));
+    // The loader holds ring_capacity to [2, 30]; a config made in code is held there too.
+    const auto cap = static_cast<std::size_t>(std::clamp(c.runtime.ring_capacity, 2, 30));
     odo_in = std::make_unique<SpscRing<FramePacket>>(cap);
     // Result rings are only ever short (the feedback thread is light); a few times the frame
     // ring so a slow log write never stalls the stages.
@@ -339,6 +354,7 @@ struct Runtime::Impl {
       const ReadResult r = source->read(*frame);
       beat(kCapture);
       if (r.ok()) {
+        check_timestamp(*frame, cfg_now->capture.fps);
         if (!live && opt.realtime) pace(frame->timestamp, cfg_now->capture.fps);
         if (stop.load()) return NextFrame::kStopped;
         p.captured = Clock::now();
@@ -350,6 +366,10 @@ struct Runtime::Impl {
       }
       if (r.status == ReadStatus::kEnd) {
         spdlog::info("{}: end of input{}{}", source->describe(), r.message.empty() ? "" : ": ", r.message);
+        if (ts_replaced.load() > 0)
+          spdlog::warn("{}: {} of {} frames had a timestamp that could not be trusted and were timed by the "
+                       "frame clock instead",
+                       source->describe(), ts_replaced.load(), next_seq);
         return NextFrame::kEnd;
       }
       if (!live) {
@@ -370,6 +390,27 @@ struct Runtime::Impl {
       backoff = std::min<double>(backoff * 2.0, cfg_now->capture.retry_max);
     }
     return NextFrame::kStopped;
+  }
+
+  /// Frame times the stages can trust (frame_clock.hpp): a timestamp that is not finite, does not
+  /// increase or leaps forward is replaced, with a warning naming the frame; the run goes on.
+  /// A live camera's replacement step is the wall-clock time since the previous frame, a
+  /// replay's one nominal frame period.
+  void check_timestamp(RgbdFrame& f, int fps) {
+    const auto now = Clock::now();
+    if (!frame_clock) frame_clock = std::make_unique<FrameClock>(1.0 / std::max(1, fps));
+    const double wall = live && last_read != Clock::time_point{} ? seconds_between(last_read, now) : -1.0;
+    last_read = now;
+    const double raw = f.timestamp;
+    const FrameTime t = frame_clock->next(raw, wall);
+    f.timestamp = t.t;
+    if (!t.replaced) return;
+    const std::uint64_t n = ts_replaced.fetch_add(1) + 1;
+    // Every frame of a recording with equal timestamps would warn: the first few, then one in 100.
+    if (n <= 5 || n % 100 == 0)
+      spdlog::warn("{}: frame {} (#{} of the run): timestamp {} {}; timed {:.6f} s instead{}", source->describe(),
+                   f.index, next_seq, raw, t.why, t.t,
+                   n == 5 ? " (further ones are logged one in 100)" : n > 5 ? " (" + std::to_string(n) + " so far)" : "");
   }
 
   /// Real-time replay: hold the frame until its timestamp comes due on the wall clock.
@@ -511,8 +552,7 @@ struct Runtime::Impl {
       }
       odo_in_space.ring();
       apply_config(gen, [&](const PipelineConfig& c) {
-        odometry->reconfigure(c);
-        odo_restarted = true;
+        if (odometry->reconfigure(c)) odo_restarted = true;
       });
       OdoMsg m = run_odometry(p);
       p.frame.reset();
@@ -640,6 +680,12 @@ struct Runtime::Impl {
   }
 
   void on_odometry(OdoMsg& m) {
+    const double lag = ms_between(m.captured, Clock::now());
+    {
+      std::lock_guard<std::mutex> lk(stats_mutex);
+      odo_lag.add(lag);
+      interval_odo_lag.add(lag);
+    }
     odo_high = std::max(odo_high, m.out.seq + 1);
     last_odometry = m.out;
     have_last_odometry = true;
@@ -752,30 +798,41 @@ struct Runtime::Impl {
     if (!force && dt < c->runtime.status_interval) return;
     const std::uint64_t cur[5] = {captured.load(), odo_frames.load(), perc_frames.load(), skipped_count(),
                                   lost_count()};
-    double p50 = 0, p99 = 0;
+    double p50 = 0, p99 = 0, lag50 = 0, lag99 = 0;
     {
       std::lock_guard<std::mutex> lk(stats_mutex);
       p50 = interval_latency.percentile(50);
       p99 = interval_latency.percentile(99);
       interval_latency.clear();
+      lag50 = interval_odo_lag.percentile(50);
+      lag99 = interval_odo_lag.percentile(99);
+      interval_odo_lag.clear();
     }
     const double inv = dt > 0 ? 1.0 / dt : 0.0;
     const auto d = [&](int i) { return static_cast<double>(cur[i] - status_base[i]); };
     const double seen = d(2) + d(3);
-    char buf[512];
+    char buf[640];
     std::snprintf(
         buf, sizeof buf,
         "%s: capture %.1f fps, odometry %.1f fps, perception %.1f fps, skipped %.0f (%.1f%%), lost %.0f, "
-        "latency p50 %.1f ms p99 %.1f ms, totals %llu frames %llu skipped %llu lost, cfg %llu",
+        "latency p50 %.1f ms p99 %.1f ms, odometry lag p50 %.1f ms p99 %.1f ms, totals %llu frames %llu "
+        "skipped %llu lost, cfg %llu",
         state_name(get_state()), d(0) * inv, d(1) * inv, d(2) * inv, d(3),
-        seen > 0 ? 100.0 * d(3) / seen : 0.0, d(4), p50, p99, static_cast<unsigned long long>(cur[0]),
+        seen > 0 ? 100.0 * d(3) / seen : 0.0, d(4), p50, p99, lag50, lag99, static_cast<unsigned long long>(cur[0]),
         static_cast<unsigned long long>(cur[3]), static_cast<unsigned long long>(cur[4]),
         static_cast<unsigned long long>(cfg_gen.load()));
+    // The step count and its cues are only as fresh as the odometry's poses.
+    if (lag99 > kLagWarnMs)
+      spdlog::warn("odometry {:.1f} s behind the camera (p99 over the last {:.1f} s): step counts and their cues "
+                   "come that late; the machine is too slow for this frame size and rate",
+                   lag99 / 1000.0, dt);
     std::copy(cur, cur + 5, status_base);
     last_status = now;
     spdlog::info("{}", buf);
     notify(std::string("STATUS=") + buf);
   }
+
+  static constexpr double kLagWarnMs = 1000.0;
 
   void sink_loop() {
     std::uint64_t gen = 1;
@@ -820,6 +877,43 @@ struct Runtime::Impl {
     finish(kSink);
   }
 
+  /// Runs a worker's loop. What escapes it (out of memory under a tight limit, a library's
+  /// exception) is logged, fails the run and stops every thread: uncaught, it ended the process
+  /// through std::terminate with no log line (issue 41, under `ulimit -v 256000`).
+  template <class F>
+  void guarded(int w, F&& loop, const char* name = nullptr) {
+    try {
+      loop();
+      return;
+    } catch (const std::bad_alloc&) {
+      fail_worker(w, name, kOutOfMemory);
+    } catch (const std::exception& e) {
+      fail_worker(w, name, e.what());
+    } catch (...) {
+      fail_worker(w, name, "an unknown exception");
+    }
+  }
+  static constexpr const char* kOutOfMemory =
+      "out of memory (std::bad_alloc): the memory limit (ulimit -v, the unit's MemoryMax=) is too small "
+      "for the pipeline at this frame size";
+
+  void fail_worker(int w, const char* name, const char* why) noexcept {
+    if (!name) name = worker_name(w);
+    try {
+      spdlog::critical("{} thread failed: {}; stopping", name, why);
+      notify(std::string("STATUS=failed: ") + name + " thread: " + why);
+    } catch (...) {
+      // Logging itself ran out of memory: say it without allocating.
+      static const char msg[] = "stairguided: a thread failed (out of memory?); stopping\n";
+      [[maybe_unused]] const auto n = ::write(2, msg, sizeof msg - 1);
+    }
+    exit_code.store(1);
+    set_state(State::kFailed);
+    stop.store(true);
+    if (!done[w].load()) finish(w);
+    ring_all();
+  }
+
   void finish(int w) {
     {
       std::lock_guard<std::mutex> lk(exit_mutex);
@@ -828,6 +922,8 @@ struct Runtime::Impl {
     exit_cv.notify_all();
     ring_all();
   }
+
+  void run_synchronous(std::uint64_t& gen);
 
   bool all_done() const {
     for (const auto& d : done)
@@ -857,12 +953,17 @@ struct Runtime::Impl {
     s.latency_p50_ms = latency.percentile(50);
     s.latency_p99_ms = latency.percentile(99);
     s.latency_max_ms = latency.max();
+    s.odometry_lag_p50_ms = odo_lag.percentile(50);
+    s.odometry_lag_p99_ms = odo_lag.percentile(99);
+    s.odometry_lag_max_ms = odo_lag.max();
+    s.timestamps_replaced = ts_replaced.load();
     const FeedbackStage::CueLatency cl = feedback->cue_latency();
     s.cues = cl.cues;
     s.cues_sounded = cl.sounded;
     s.cue_latency_p50_ms = cl.p50_ms;
     s.cue_latency_p99_ms = cl.p99_ms;
     s.last_cue = cl.last;
+    s.cues_lost = cl.lost;
     if (have_first && have_last) s.elapsed_s = std::max(0.0, seconds_between(first_capture, last_decision));
     if (last_traversal.ran) {
       s.traversal_state = to_string(last_traversal.state);
@@ -918,10 +1019,22 @@ void Runtime::start() {
     m.notify(ready);
     return;
   }
-  m.threads[kCapture] = std::thread([&m] { m.capture_loop(); });
-  m.threads[kOdometry] = std::thread([&m] { m.odometry_loop(); });
-  m.threads[kPerception] = std::thread([&m] { m.perception_loop(); });
-  m.threads[kSink] = std::thread([&m] { m.sink_loop(); });
+  // A thread that cannot be had (out of threads or memory) is its own error, not the input's: it
+  // read "cannot open input" (issue 41). The ones already started are stopped (and joined by the
+  // destructor).
+  const std::function<void()> loops[kWorkers] = {
+      [&m] { m.guarded(kCapture, [&m] { m.capture_loop(); }); },
+      [&m] { m.guarded(kOdometry, [&m] { m.odometry_loop(); }); },
+      [&m] { m.guarded(kPerception, [&m] { m.perception_loop(); }); },
+      [&m] { m.guarded(kSink, [&m] { m.sink_loop(); }); }};
+  for (int w = 0; w < kWorkers; ++w) {
+    try {
+      m.threads[w] = m.opt.start_thread ? m.opt.start_thread(worker_name(w), loops[w]) : std::thread(loops[w]);
+    } catch (const std::exception& e) {
+      request_stop();
+      throw StartError(std::string("cannot start the ") + worker_name(w) + " thread: " + e.what());
+    }
+  }
   m.notify(ready);
 }
 
@@ -936,6 +1049,21 @@ int Runtime::run() {
   }
   // Synchronous mode: the same stages in order on this thread, every frame through each.
   std::uint64_t gen = 1;
+  m.guarded(kCapture, [&] { m.run_synchronous(gen); }, "pipeline (one thread)");
+  if (m.done[kCapture].load()) {  // failed (guarded logged it): nothing more to play
+    m.source.reset();
+    for (auto& d : m.done) d.store(true);
+    return exit_code();
+  }
+  m.emit_lines(m.next_seq, true, true);
+  if (!m.stop.load()) m.feedback->drain(Ms(3000));  // the input ended: let the last cues be heard
+  m.source.reset();
+  for (auto& d : m.done) d.store(true);
+  return exit_code();
+}
+
+void Runtime::Impl::run_synchronous(std::uint64_t& gen) {
+  Impl& m = *this;
   for (;;) {
     if (m.opt.max_frames >= 0 && static_cast<long>(m.next_seq) >= m.opt.max_frames) {
       m.set_state(State::kEnded);
@@ -963,8 +1091,7 @@ int Runtime::run() {
     }
     if (m.get_state() == State::kStarting) m.set_state(State::kRunning);
     m.apply_config(gen, [&](const PipelineConfig& c) {
-      m.odometry->reconfigure(c);
-      m.odo_restarted = true;
+      if (m.odometry->reconfigure(c)) m.odo_restarted = true;
       m.perception->reconfigure(c);
       m.feedback->reconfigure(c);
     });
@@ -983,11 +1110,6 @@ int Runtime::run() {
     m.maybe_watchdog();
     m.maybe_report();
   }
-  m.emit_lines(m.next_seq, true, true);
-  if (!m.stop.load()) m.feedback->drain(Ms(3000));  // the input ended: let the last cues be heard
-  m.source.reset();
-  for (auto& d : m.done) d.store(true);
-  return exit_code();
 }
 
 bool Runtime::finished() const { return impl_->all_done(); }
@@ -1030,9 +1152,13 @@ bool Runtime::join(std::chrono::milliseconds timeout) {
   return all;
 }
 
-void Runtime::reconfigure(const PipelineConfig& config) {
+bool Runtime::reconfigure(const PipelineConfig& config) {
   Impl& m = *impl_;
   const auto old = m.config();
+  // The same file reloaded (a SIGHUP storm, a `systemctl reload` to be sure): nothing to apply.
+  // Taken, each reload restarted the odometry's track and perception's memory, and 50 of them
+  // before a flight delayed "first step" by 25 frames (issue 41).
+  if (config_equal(*old, config)) return false;
   {
     std::lock_guard<std::mutex> lk(m.cfg_mutex);
     m.cfg = std::make_shared<const PipelineConfig>(config);
@@ -1050,6 +1176,7 @@ void Runtime::reconfigure(const PipelineConfig& config) {
   if (m.live && !config_equal(a, b, &diff) && diff.rfind("capture.", 0) == 0)
     spdlog::info("capture settings apply when the camera is next opened ({})", diff);
   m.ring_all();
+  return true;
 }
 
 RuntimeStats Runtime::stats() const { return impl_->stats(); }

@@ -61,6 +61,14 @@ class FrameSource {
   virtual bool independent_frames() const { return false; }
 };
 
+/// Why `path` cannot be read, in words for a person: "" when it can be opened for reading (a
+/// directory when `directory`), else "no such file", "permission denied", "a symbolic link loop
+/// (too many levels of symbolic links)", "not a directory" (a component of the path), or the
+/// system's words. Permission denied must not read as missing or corrupt (issue 41).
+std::string why_unreadable(const std::string& path, bool directory = false);
+/// The words why_unreadable() uses for an errno value (ENOENT, EACCES, ELOOP, ...).
+std::string errno_words(int err);
+
 /// Opens an input by name: a directory is a dataset folder, a path ending in .oni an OpenNI2
 /// recording, "device" or "device:URI" the live camera, "synth:SCENE[:FRAMES[:SEED]]" the renderer.
 /// Depth outside [config.min_range, config.max_range] reads as no reading (0), whatever the source.

@@ -660,13 +660,15 @@ struct OdometryConfig {
 
 struct RuntimeConfig {
   std::string log_level = "info";  ///< spdlog level
-  int ring_capacity = 8;           ///< frames per ring buffer
+  int ring_capacity = 8;           ///< frames per ring buffer (at most 30: one second at 30 Hz)
   float status_interval = 5.0f;    ///< s between counter logs / STATUS updates
   bool realtime = true;            ///< replay paced by timestamps (false: as fast as possible)
 
   template <class V> void visit(V& v) {
     v.text(log_level, "log_level", {"trace", "debug", "info", "warn", "error", "critical", "off"}, "log level");
-    v.num(ring_capacity, "ring_capacity", Unit::kCount, 2, 1024, "frames held by each ring buffer");
+    // At most about a second of frames at 30 Hz (the ring is rounded up to a power of two: 32):
+    // 1024 let a slow odometry fall 20 s behind the camera with 1.4 GB of frames held (issue 41).
+    v.num(ring_capacity, "ring_capacity", Unit::kCount, 2, 30, "frames held by each ring buffer");
     v.num(status_interval, "status_interval_s", Unit::kSecond, 0.1, 3600, "seconds between counter reports");
     v.flag(realtime, "realtime_replay", "pace a replay by its timestamps (false: as fast as possible)");
   }

@@ -94,8 +94,9 @@ class OdometryStage {
   OdometryStage& operator=(const OdometryStage&) = delete;
 
   OdometryOutput step(const RgbdFrame& frame);
-  /// Applies a new config; the odometry keeps its pose but restarts from the next frame.
-  void reconfigure(const PipelineConfig& config);
+  /// Applies a new config; when its odometry section changed, the odometry keeps its pose but
+  /// restarts from the next frame, and true is returned. Other sections change nothing here.
+  bool reconfigure(const PipelineConfig& config);
   /// After a camera reconnect: the next frame starts a new track from the last pose.
   void restart();
   bool available() const;
@@ -160,6 +161,7 @@ class FeedbackStage {
   struct CueLatency {
     std::uint64_t cues = 0;     ///< cues given (all sinks)
     std::uint64_t sounded = 0;  ///< of them, started on the sound device
+    std::uint64_t lost = 0;     ///< of them, dropped unplayed (the sound device could not take them)
     double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
     std::string last;  ///< token of the last cue given ("" none)
   };

@@ -24,7 +24,9 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/core/config.hpp"
@@ -32,6 +34,11 @@
 #include "stairguide/runtime/pipeline.hpp"
 
 namespace stairguide::runtime {
+
+/// Runtime::start() could not start a thread (out of threads or memory): not the input's fault.
+struct StartError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// Opens an input by name (default: open_frame_source). Throws SourceError.
 using SourceFactory =
@@ -70,6 +77,9 @@ struct RuntimeOptions {
   /// Synchronous mode only: called on the calling thread once a frame has been through every
   /// stage and the feedback decision. An exception it throws ends run() and reaches its caller.
   std::function<void(const FrameObservation&)> observer;
+  /// Starts worker thread `name` running `body` (empty: std::thread). A seam for tests of a
+  /// thread that cannot be started; throws what std::thread throws.
+  std::function<std::thread(const char* name, std::function<void()> body)> start_thread;
 };
 
 /// Counters of a run. Rates are over the whole run unless named `interval_`.
@@ -92,10 +102,19 @@ struct RuntimeStats {
   double latency_p50_ms = 0.0;        ///< capture -> feedback decision
   double latency_p99_ms = 0.0;
   double latency_max_ms = 0.0;
+  /// Capture -> the odometry's result at the feedback thread: how old the poses the step count
+  /// works with are (a slow odometry shows here; perception always takes the newest frame).
+  double odometry_lag_p50_ms = 0.0;
+  double odometry_lag_p99_ms = 0.0;
+  double odometry_lag_max_ms = 0.0;
+  /// Frames whose timestamp could not be trusted (not finite, not increasing, a leap) and were
+  /// timed by the frame clock instead (frame_clock.hpp).
+  std::uint64_t timestamps_replaced = 0;
   double odometry_ms_mean = 0.0;  ///< mean time in the odometry stage
   double perception_ms_mean = 0.0;
   std::uint64_t cues = 0;          ///< cues given to the user (feedback)
   std::uint64_t cues_sounded = 0;  ///< of them, started on the sound device
+  std::uint64_t cues_lost = 0;     ///< of them, never played: the sound device could not take them
   double cue_latency_p50_ms = 0.0; ///< capture of the frame warranting a cue -> its first sample out
   double cue_latency_p99_ms = 0.0;
   std::string last_cue;            ///< token of the last cue ("" none)
@@ -139,13 +158,15 @@ class Runtime {
 
   /// Hands a new, already validated config to the stages (each applies it between two frames).
   /// Capture settings take effect at the next (re)open; ring capacities at the next start.
-  void reconfigure(const PipelineConfig& config);
+  /// A config equal to the running one changes nothing (no new generation, no stage touched) and
+  /// returns false: a burst of reloads of the same file must not perturb the count on a flight.
+  bool reconfigure(const PipelineConfig& config);
 
   /// Snapshot of the counters (any thread, any time).
   RuntimeStats stats() const;
 
   /// 0 when the input ended cleanly or stop was requested, 1 when a replay failed mid-way (an
-  /// unreadable frame).
+  /// unreadable frame) or a thread failed (out of memory: logged).
   int exit_code() const;
   /// Why a replay failed mid-way, naming the input and the frame ("" when it did not).
   std::string failure() const;
