@@ -506,7 +506,8 @@ struct StairDetectionConfig {
 };
 
 struct StairModellingConfig {
-  // Defaults: the range of the world's building codes (../shared/data/SOURCES.md: USA IRC/IBC, UK
+  // The building code here only describes a staircase (stairs/stair_checks.hpp: StairCodeNote);
+  // what cannot be walked is physics (WalkableLimits) and never configured. Defaults: the range of the world's building codes (../shared/data/SOURCES.md: USA IRC/IBC, UK
   // Approved Document K, Germany DIN 18065, Spain CTE); config/profiles/paper.yaml restores the
   // paper's Spanish code (riser 13-18.5, tread >= 28, 2R+T 54-70 cm).
   float riser_min = 0.10f;        ///< m, building code
@@ -522,12 +523,12 @@ struct StairModellingConfig {
   float tread_tolerance_per_m2 = 0.004f;  ///< m per m^2 of distance: extra slack on tread and 2R+T far away
 
   template <class V> void visit(V& v) {
-    v.num(riser_min, "riser_min_cm", Unit::kCentimetre, 1, 100, "building code: lowest riser");
-    v.num(riser_max, "riser_max_cm", Unit::kCentimetre, 1, 100, "building code: highest riser");
-    v.num(tread_min, "tread_min_cm", Unit::kCentimetre, 1, 200, "building code: shortest tread");
-    v.num(blondel_min, "blondel_min_cm", Unit::kCentimetre, 10, 300, "building code: lowest 2R+T");
-    v.num(blondel_max, "blondel_max_cm", Unit::kCentimetre, 10, 300, "building code: highest 2R+T");
-    v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "narrowest staircase");
+    v.num(riser_min, "riser_min_cm", Unit::kCentimetre, 1, 100, "building code described (never a reason for silence): lowest riser");
+    v.num(riser_max, "riser_max_cm", Unit::kCentimetre, 1, 100, "building code described: highest riser (over it: \"steep\")");
+    v.num(tread_min, "tread_min_cm", Unit::kCentimetre, 1, 200, "building code described: shortest tread (under it: \"steep\")");
+    v.num(blondel_min, "blondel_min_cm", Unit::kCentimetre, 10, 300, "building code described: lowest 2R+T");
+    v.num(blondel_max, "blondel_max_cm", Unit::kCentimetre, 10, 300, "building code described: highest 2R+T");
+    v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "building code described: narrowest staircase (what cannot be walked is fixed: rise 5-25 cm, tread >= 15 cm, width >= 40 cm)");
     v.num(manhattan_min_fraction, "manhattan_min_percent", Unit::kPercent, 0, 100,
           "share of Manhattan points needed to take the stair axes from the Manhattan frame");
     v.num(manhattan_max_disagreement, "manhattan_max_disagreement_deg", Unit::kDegree, 0, 45,
