@@ -228,6 +228,32 @@ void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrins
   const bool refit = v == StairVerdict::kDetected || v == StairVerdict::kTreadTooShort ||
                      v == StairVerdict::kBlondelOutOfRange || v == StairVerdict::kInconsistentEdges;
   if (!refit || static_cast<int>(out.level_data.size()) != n + 1) return;
+  collect_seen_edges(scene, K, dir, n, out);
+  float shift = 0.f;  // new origin along z_S, in the current stair frame
+  if (edge_k_.size() >= 2) {
+    if (!fit_seen_edges(dir, out, shift)) return;
+  } else {
+    // One edge or none seen: the tread is unknown. The origin stays on the first level's seen
+    // boundary unless its edge is seen.
+    out.tread_m = 0.f;
+    if (edge_k_.size() == 1 && edge_k_[0] == 1.f) shift = edge_e_[0];
+  }
+  if (shift != 0.f) shift_origin(n, shift, out);
+  // Validation again, as modelling does, with the tread from the seen edges (none when unknown).
+  StairDimensions dims;
+  dims.riser = out.riser_m;
+  dims.tread = out.tread_m;
+  dims.tread_known = edge_k_.size() >= 2;
+  dims.width = out.width_m;
+  dims.width_complete = out.width_complete;
+  dims.range = out.T_camera_stair.translation().norm();
+  out.verdict = check_walkable(dims, mod_.dimension_tolerance, mod_.tread_tolerance_per_m2);
+  out.code_notes = describe_against_code(dims, true, mod_);
+  out.detected = out.verdict == StairVerdict::kDetected;
+}
+
+void FloorlessStairs::collect_seen_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n,
+                                         StairResult& out) {
   const float y_origin = dir > 0 ? out.level_data[1].height : 0.f;
   edge_k_.clear();
   edge_e_.clear();
@@ -266,82 +292,69 @@ void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrins
     edge_e_.push_back(e);
   }
   trace_.edges_seen = static_cast<int>(edge_k_.size());
-  float shift = 0.f;  // new origin along z_S, in the current stair frame
-  if (edge_k_.size() >= 2) {
-    // Consensus, as modelling does: the line through two edges that most edges lie near (within
-    // edge_max_residual), refitted to those; two thirds of the edges must agree.
-    const std::size_t q = edge_k_.size();
-    std::size_t best_in = 0;
-    float best_res = std::numeric_limits<float>::max(), best_slope = 0.f, best_icpt = 0.f;
-    for (std::size_t i = 0; i < q; ++i) {
-      for (std::size_t j = i + 1; j < q; ++j) {
-        const float sl = (edge_e_[j] - edge_e_[i]) / (edge_k_[j] - edge_k_[i]);
-        const float ic = edge_e_[i] - sl * edge_k_[i];
-        std::size_t in = 0;
-        float res = 0.f;
-        for (std::size_t k = 0; k < q; ++k) {
-          const float d = std::fabs(edge_e_[k] - (ic + sl * edge_k_[k]));
-          if (d <= mod_.edge_max_residual) {
-            ++in;
-            res += d;
-          }
-        }
-        if (in > best_in || (in == best_in && res < best_res)) {
-          best_in = in;
-          best_res = res;
-          best_slope = sl;
-          best_icpt = ic;
+}
+
+bool FloorlessStairs::fit_seen_edges(int dir, StairResult& out, float& shift) const {
+  // Consensus, as modelling does: the line through two edges that most edges lie near (within
+  // edge_max_residual), refitted to those; two thirds of the edges must agree.
+  const std::size_t q = edge_k_.size();
+  std::size_t best_in = 0;
+  float best_res = std::numeric_limits<float>::max(), best_slope = 0.f, best_icpt = 0.f;
+  for (std::size_t i = 0; i < q; ++i) {
+    for (std::size_t j = i + 1; j < q; ++j) {
+      const float sl = (edge_e_[j] - edge_e_[i]) / (edge_k_[j] - edge_k_[i]);
+      const float ic = edge_e_[i] - sl * edge_k_[i];
+      std::size_t in = 0;
+      float res = 0.f;
+      for (std::size_t k = 0; k < q; ++k) {
+        const float d = std::fabs(edge_e_[k] - (ic + sl * edge_k_[k]));
+        if (d <= mod_.edge_max_residual) {
+          ++in;
+          res += d;
         }
       }
-    }
-    double sk = 0, se = 0, skk = 0, ske = 0, cnt = 0;
-    for (std::size_t i = 0; i < q; ++i) {
-      if (std::fabs(edge_e_[i] - (best_icpt + best_slope * edge_k_[i])) > mod_.edge_max_residual) continue;
-      sk += edge_k_[i];
-      se += edge_e_[i];
-      skk += static_cast<double>(edge_k_[i]) * edge_k_[i];
-      ske += static_cast<double>(edge_k_[i]) * edge_e_[i];
-      cnt += 1;
-    }
-    const double den = cnt * skk - sk * sk;
-    const float slope = std::fabs(den) > 1e-9 ? static_cast<float>((cnt * ske - sk * se) / den) : best_slope;
-    const float icpt = std::fabs(den) > 1e-9 ? static_cast<float>((se - slope * sk) / cnt) : best_icpt;
-    out.tread_m = slope;
-    shift = dir > 0 ? icpt + slope : icpt;
-    if (best_in < 2 || 3 * best_in < 2 * q) {
-      out.detected = false;
-      out.verdict = StairVerdict::kInconsistentEdges;
-      return;
-    }
-  } else {
-    // One edge or none seen: the tread is unknown. The origin stays on the first level's seen
-    // boundary unless its edge is seen.
-    out.tread_m = 0.f;
-    if (edge_k_.size() == 1 && edge_k_[0] == 1.f) shift = edge_e_[0];
-  }
-  if (shift != 0.f) {
-    const Eigen::Vector3f zs = out.T_camera_stair.linear().col(2);
-    out.T_camera_stair.translation() += zs * shift;
-    out.edge_left += zs * shift;
-    out.edge_right += zs * shift;
-    for (int k = 1; k <= n; ++k) {
-      StairLevel& l = out.level_data[static_cast<std::size_t>(k)];
-      l.edge -= shift;
-      l.depth_min -= shift;
-      l.depth_max -= shift;
+      if (in > best_in || (in == best_in && res < best_res)) {
+        best_in = in;
+        best_res = res;
+        best_slope = sl;
+        best_icpt = ic;
+      }
     }
   }
-  // Validation again, as modelling does, with the tread from the seen edges (none when unknown).
-  StairDimensions dims;
-  dims.riser = out.riser_m;
-  dims.tread = out.tread_m;
-  dims.tread_known = edge_k_.size() >= 2;
-  dims.width = out.width_m;
-  dims.width_complete = out.width_complete;
-  dims.range = out.T_camera_stair.translation().norm();
-  out.verdict = check_walkable(dims, mod_.dimension_tolerance, mod_.tread_tolerance_per_m2);
-  out.code_notes = describe_against_code(dims, true, mod_);
-  out.detected = out.verdict == StairVerdict::kDetected;
+  double sk = 0, se = 0, skk = 0, ske = 0, cnt = 0;
+  for (std::size_t i = 0; i < q; ++i) {
+    if (std::fabs(edge_e_[i] - (best_icpt + best_slope * edge_k_[i])) > mod_.edge_max_residual) continue;
+    sk += edge_k_[i];
+    se += edge_e_[i];
+    skk += static_cast<double>(edge_k_[i]) * edge_k_[i];
+    ske += static_cast<double>(edge_k_[i]) * edge_e_[i];
+    cnt += 1;
+  }
+  const double den = cnt * skk - sk * sk;
+  const float slope = std::fabs(den) > 1e-9 ? static_cast<float>((cnt * ske - sk * se) / den) : best_slope;
+  const float icpt = std::fabs(den) > 1e-9 ? static_cast<float>((se - slope * sk) / cnt) : best_icpt;
+  out.tread_m = slope;
+  shift = dir > 0 ? icpt + slope : icpt;
+  if (best_in < 2 || 3 * best_in < 2 * q) {
+    out.detected = false;
+    out.verdict = StairVerdict::kInconsistentEdges;
+    return false;
+  }
+  return true;
+}
+
+
+void FloorlessStairs::shift_origin(int n, float shift, StairResult& out) {
+  const Eigen::Vector3f zs = out.T_camera_stair.linear().col(2);
+  out.T_camera_stair.translation() += zs * shift;
+  out.edge_left += zs * shift;
+  out.edge_right += zs * shift;
+  for (int k = 1; k <= n; ++k) {
+    StairLevel& l = out.level_data[static_cast<std::size_t>(k)];
+    l.edge -= shift;
+    l.depth_min -= shift;
+    l.depth_max -= shift;
+  }
 }
 
 }  // namespace stairguide

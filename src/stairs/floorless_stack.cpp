@@ -48,6 +48,32 @@ bool FloorlessStairs::connected(const Node& a, const Node& b) const {
   return false;
 }
 
+std::size_t FloorlessStairs::merge_connected_nodes(std::size_t first, std::size_t used) {
+  bool merged = true;
+  while (merged) {
+    merged = false;
+    for (std::size_t a = first; a < used && !merged; ++a) {
+      for (std::size_t b = a + 1; b < used && !merged; ++b) {
+        if (!connected(nodes_[a], nodes_[b]) && !connected(nodes_[b], nodes_[a])) continue;
+        Node& A = nodes_[a];
+        Node& B = nodes_[b];
+        A.height = (A.height * static_cast<float>(A.pixels) + B.height * static_cast<float>(B.pixels)) /
+                   static_cast<float>(A.pixels + B.pixels);
+        A.pixels += B.pixels;
+        A.regions.insert(A.regions.end(), B.regions.begin(), B.regions.end());
+        A.sample.insert(A.sample.end(), B.sample.begin(), B.sample.end());
+        A.lo = A.lo.cwiseMin(B.lo);
+        A.hi = A.hi.cwiseMax(B.hi);
+        A.stride = std::max(A.stride, B.stride);
+        std::swap(nodes_[b], nodes_[used - 1]);
+        --used;
+        merged = true;
+      }
+    }
+  }
+  return used;
+}
+
 void FloorlessStairs::build_nodes(const SceneResult& scene) {
   const Eigen::Vector3f up = trace_.up;
   height_.resize(family_.size());
@@ -100,28 +126,7 @@ void FloorlessStairs::build_nodes(const SceneResult& scene) {
       n.pixels = scene.regions[static_cast<std::size_t>(family_[m])].pixel_count;
       n.height = height_[m];
     }
-    bool merged = true;
-    while (merged) {
-      merged = false;
-      for (std::size_t a = first; a < used && !merged; ++a) {
-        for (std::size_t b = a + 1; b < used && !merged; ++b) {
-          if (!connected(nodes_[a], nodes_[b]) && !connected(nodes_[b], nodes_[a])) continue;
-          Node& A = nodes_[a];
-          Node& B = nodes_[b];
-          A.height = (A.height * static_cast<float>(A.pixels) + B.height * static_cast<float>(B.pixels)) /
-                     static_cast<float>(A.pixels + B.pixels);
-          A.pixels += B.pixels;
-          A.regions.insert(A.regions.end(), B.regions.begin(), B.regions.end());
-          A.sample.insert(A.sample.end(), B.sample.begin(), B.sample.end());
-          A.lo = A.lo.cwiseMin(B.lo);
-          A.hi = A.hi.cwiseMax(B.hi);
-          A.stride = std::max(A.stride, B.stride);
-          std::swap(nodes_[b], nodes_[used - 1]);
-          --used;
-          merged = true;
-        }
-      }
-    }
+    used = merge_connected_nodes(first, used);
     i = j;
   }
   // Levels too small to be a tread seen in part are left out (a box top, a book).

@@ -71,6 +71,50 @@ bool StairModelling::floor_doubtful(const SceneResult& scene, const StairHypothe
   return false;
 }
 
+bool StairModelling::far_side_out_of_view(const StairFrame& frame, float a_mid, float edge_b,
+                                          const StairLevel& o) const {
+  if (!K_) return false;
+  const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
+  const Eigen::Vector3f p =
+      xs * (a_mid + 0.5f * (o.lateral_min + o.lateral_max)) + up * levels_[1].plane + zs * (edge_b + o.depth_max);
+  const float margin = 0.02f * static_cast<float>(std::max(K_->width, K_->height));
+  const float u = K_->fx * p.x() / p.z() + K_->cx, v = K_->fy * p.y() / p.z() + K_->cy;
+  return p.z() < 0.05f || u < margin || v < margin || u > static_cast<float>(K_->width) - margin ||
+         v > static_cast<float>(K_->height) - margin;
+}
+
+bool StairModelling::strip_at_floor_edge_shadow(float riser, const StairLevel& o, const StairResult& out) const {
+  const Eigen::Vector3f cam = out.T_camera_stair.inverse().translation();  // camera in S
+  const float H = cam.y(), D = -cam.z();
+  if (H > 0.3f && D > 0.f) {
+    const float shadow = D * riser / H;
+    // Slack: the edge and the strip's near boundary are each measured to a few cm, worse far.
+    const float slack = 0.04f + 0.01f * D * D;
+    return std::fabs(o.depth_min - shadow) < slack;
+  }
+  return false;
+}
+
+bool StairModelling::surface_above(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame,
+                                   float a_mid, float edge_b, const StairLevel& o) const {
+  const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
+  const float cos_par = std::cos(cls_.parallel_threshold);
+  const auto& level_regions = hyp.levels[1].regions;
+  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
+    const PlaneRegion& r = scene.regions[i];
+    if (r.cls != RegionClass::kStepCandidate && r.cls != RegionClass::kObstacle) continue;
+    if (std::fabs(r.normal.dot(up)) < cos_par) continue;
+    if (std::find(level_regions.begin(), level_regions.end(), static_cast<int>(i)) != level_regions.end()) continue;
+    const float above = up.dot(r.centroid) - levels_[1].plane;
+    if (above < 0.05f || above > 2.0f) continue;
+    const float a = xs.dot(r.centroid) - a_mid, b = zs.dot(r.centroid) - edge_b;
+    if (a > o.lateral_min + 0.1f && a < o.lateral_max - 0.1f && b > o.depth_min + 0.1f && b < o.depth_max - 0.1f) {
+      return true;
+    }
+  }
+  return false;
+}
+
 void StairModelling::decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir,
                                          const StairFrame& frame, const StairSpan& span, const FloorSeen& floor,
                                          float riser, const StairOrigin& origin_, StairResult& out) const {
@@ -87,15 +131,7 @@ void StairModelling::decide_single_level(const SceneResult& scene, const StairHy
   const float depth = o.depth_max - o.depth_min;
   const int cut = (seen[0] ? 0 : 1) + (seen[1] ? 0 : 1);
   // Does the level run out of the image at its far side (its depth then only a lower bound)?
-  bool far_cut = false;
-  if (K_) {
-    const Eigen::Vector3f p =
-        xs * (a_mid + 0.5f * (o.lateral_min + o.lateral_max)) + up * levels_[1].plane + zs * (edge_b + o.depth_max);
-    const float margin = 0.02f * static_cast<float>(std::max(K_->width, K_->height));
-    const float u = K_->fx * p.x() / p.z() + K_->cx, v = K_->fy * p.y() / p.z() + K_->cy;
-    far_cut = p.z() < 0.05f || u < margin || v < margin || u > static_cast<float>(K_->width) - margin ||
-              v > static_cast<float>(K_->height) - margin;
-  }
+  const bool far_cut = far_side_out_of_view(frame, a_mid, edge_b, o);
   // Another floor level (a curb) is deeper than a step platform, or runs out of view on both
   // sides and at the far side (seen shallower than a step platform, only when wider than any
   // furniture board); a platform whose far edge is seen, or a narrower one running out of view,
@@ -109,17 +145,7 @@ void StairModelling::decide_single_level(const SceneResult& scene, const StairHy
   // beyond the edge on. A far descending flight shows only that strip of its first tread, so
   // its seen depth says nothing; a strip that starts right at the shadow of the floor's edge is
   // a drop, however shallow.
-  bool shadowed_drop = false;
-  if (dir < 0 && floor_edge) {
-    const Eigen::Vector3f cam = out.T_camera_stair.inverse().translation();  // camera in S
-    const float H = cam.y(), D = -cam.z();
-    if (H > 0.3f && D > 0.f) {
-      const float shadow = D * riser / H;
-      // Slack: the edge and the strip's near boundary are each measured to a few cm, worse far.
-      const float slack = 0.04f + 0.01f * D * D;
-      shadowed_drop = std::fabs(o.depth_min - shadow) < slack;
-    }
-  }
+  const bool shadowed_drop = dir < 0 && floor_edge && strip_at_floor_edge_shadow(riser, o, out);
   // Seen shallower than a step platform: an obstacle, unless it runs out of view at the far side
   // (its depth seen is then only where the view ends: a platform as wide as a step that goes on
   // beyond the view is one to step onto, whatever lies past it), or is the strip of a drop seen
@@ -131,20 +157,9 @@ void StairModelling::decide_single_level(const SceneResult& scene, const StairHy
   }
   // A horizontal surface above the level, within its footprint, makes it furniture (a shelf
   // board, a seat under a table top), not a step one walks onto.
-  const float cos_par = std::cos(cls_.parallel_threshold);
-  const auto& level_regions = hyp.levels[1].regions;
-  for (std::size_t i = 0; i < scene.regions.size(); ++i) {
-    const PlaneRegion& r = scene.regions[i];
-    if (r.cls != RegionClass::kStepCandidate && r.cls != RegionClass::kObstacle) continue;
-    if (std::fabs(r.normal.dot(up)) < cos_par) continue;
-    if (std::find(level_regions.begin(), level_regions.end(), static_cast<int>(i)) != level_regions.end()) continue;
-    const float above = up.dot(r.centroid) - levels_[1].plane;
-    if (above < 0.05f || above > 2.0f) continue;
-    const float a = xs.dot(r.centroid) - a_mid, b = zs.dot(r.centroid) - edge_b;
-    if (a > o.lateral_min + 0.1f && a < o.lateral_max - 0.1f && b > o.depth_min + 0.1f && b < o.depth_max - 0.1f) {
-      out.verdict = StairVerdict::kObstacle;
-      return;
-    }
+  if (surface_above(scene, hyp, frame, a_mid, edge_b, o)) {
+    out.verdict = StairVerdict::kObstacle;
+    return;
   }
   // A single level's rise: the curb's lowest (a threshold is no curb), up to what a leg climbs.
   if (riser < det_.curb_height_min - tol || riser > WalkableLimits{}.riser_max + tol) {

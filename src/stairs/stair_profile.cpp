@@ -89,8 +89,8 @@ float StairModelling::fit_riser(const StairHypothesis& hyp, int n) {
 // edge lies beyond its riser by more than that, the riser (plus the nosing measured on the
 // levels where both agree) stands for the edge. A riser moves an edge nearer, and further only
 // where the tread took in the riser's top rows (far views, below).
-void StairModelling::place_edges_at_risers(const SceneResult& scene, const StairFrame& frame, int n,
-                                           const StairSpan& span, StairResult& out) {
+void StairModelling::find_risers(const SceneResult& scene, const StairFrame& frame, int n, const StairSpan& span,
+                                 const StairResult& out) {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float a_min = span.a_min, a_max = span.a_max;
   riser_at_.assign(static_cast<std::size_t>(n + 1), std::numeric_limits<float>::quiet_NaN());
@@ -156,6 +156,13 @@ void StairModelling::place_edges_at_risers(const SceneResult& scene, const Stair
         !std::isfinite(riser_at_[static_cast<std::size_t>(k - 1)]))
       riser_at_[static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
   }
+}
+
+void StairModelling::place_edges_at_risers(const SceneResult& scene, const StairFrame& frame, int n,
+                                           const StairSpan& span, StairResult& out) {
+  const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
+  const float a_min = span.a_min, a_max = span.a_max;
+  find_risers(scene, frame, n, span, out);
   // Nosing: the edge-to-riser offset where both agree (0 when none does).
   constexpr float kMaxNosing = 0.05f;
   tmp_.clear();

@@ -196,6 +196,9 @@ class FloorlessStairs {
 
   // ---- helpers ----
   void add_to_node(const SceneResult& scene, int region, Node& node) const;
+  /// Merges the nodes first..used-1 of one height cluster while any two are connected; returns
+  /// the new end of the used nodes.
+  std::size_t merge_connected_nodes(std::size_t first, std::size_t used);
   bool connected(const Node& a, const Node& b) const;
   float near_distance(const Node& n);
   /// Positions along z_S of the risers facing the user, by band (k: between levels k-1 and k;
@@ -226,6 +229,15 @@ class FloorlessStairs {
   static void add_hidden_steps(StairResult& out, int dir, int hidden);
   /// Tread and origin from the edges seen inside the image and the risers; validation again.
   void refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+  /// The step edges seen inside the image (k, position along z_S) into edge_k_, edge_e_: a riser
+  /// facing the user (plus the nosing measured where both agree) or a tread edge not on the image
+  /// border (trace_.edges_seen).
+  void collect_seen_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+  /// Tread from the seen edges by consensus (out.tread_m) and the origin's `shift` along z_S;
+  /// false, with kInconsistentEdges, when fewer than two thirds of the edges agree.
+  bool fit_seen_edges(int dir, StairResult& out, float& shift) const;
+  /// Moves the origin `shift` along z_S, and the levels' edges and extents with it.
+  static void shift_origin(int n, float shift, StairResult& out);
 
   ClassificationConfig cls_;
   StairDetectionConfig det_;

@@ -127,6 +127,11 @@ class StairModelling {
                                int n, int dir, const StairSpan& span, StairResult& out);
   /// Profile (stair_profile.cpp): riser from the level heights.
   float fit_riser(const StairHypothesis& hyp, int n);
+  /// Going up: each level's riser below it (riser_at_, NaN: none), a vertical region facing the
+  /// user across the staircase between the level's and the one below's heights, where a step
+  /// can start.
+  void find_risers(const SceneResult& scene, const StairFrame& frame, int n, const StairSpan& span,
+                   const StairResult& out);
   /// Going up: risers facing the user place the steps' starts where the treads' edges mislead.
   void place_edges_at_risers(const SceneResult& scene, const StairFrame& frame, int n, const StairSpan& span,
                              StairResult& out);
@@ -150,6 +155,14 @@ class StairModelling {
   void decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir, const StairFrame& frame,
                            const StairSpan& span, const FloorSeen& floor, float riser, const StairOrigin& o,
                            StairResult& out) const;
+  /// Single level: does it run out of the image at its far side (its depth then only a lower bound)?
+  bool far_side_out_of_view(const StairFrame& frame, float a_mid, float edge_b, const StairLevel& o) const;
+  /// Single level below the floor: does its seen strip start at the shadow of the floor's edge (a
+  /// drop, however shallow)?
+  bool strip_at_floor_edge_shadow(float riser, const StairLevel& o, const StairResult& out) const;
+  /// Single level: a horizontal surface above it, within its footprint (furniture, no step).
+  bool surface_above(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame, float a_mid,
+                     float edge_b, const StairLevel& o) const;
   /// A flight: physical checks (stair_checks.hpp) and the edges' consistency.
   void decide_flight(int dir, const StairSpan& span, const StairProfile& profile, const StairOrigin& o,
                      StairResult& out) const;
