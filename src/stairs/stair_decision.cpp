@@ -117,13 +117,13 @@ bool StairModelling::surface_above(const SceneResult& scene, const StairHypothes
 
 void StairModelling::decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir,
                                          const StairFrame& frame, const StairSpan& span, const FloorSeen& floor,
-                                         float riser, const StairOrigin& origin_, StairResult& out) const {
+                                         float riser, const StairOrigin& pose, StairResult& out) const {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float a_mid = span.a_mid, width = span.width;
   const bool* seen = span.seen;
   const bool floor_edge = floor.edge;
-  const float edge_b = origin_.edge_b;
-  const Eigen::Vector3f& origin = origin_.origin;
+  const float edge_b = pose.edge_b;
+  const Eigen::Vector3f& origin = pose.origin;
   const float tol = cfg_.dimension_tolerance;
   // One level (paper 4.1, last paragraph): a step or curb by the building code's riser, and by
   // size: too small is an obstacle (a box, a low platform), very deep is another floor level.
