@@ -6,8 +6,6 @@
 #include <cstddef>
 #include <vector>
 
-#include "stairguide/core/types.hpp"
-
 namespace stairguide {
 namespace modelling {
 
@@ -43,12 +41,6 @@ float wrap_quarter(float a);
 /// plain extreme below kMinRobust values, NaN when empty.
 float robust_low(std::vector<float>& v);
 float robust_high(std::vector<float>& v);
-/// True when the camera-frame point `p` projects inside the image, `margin` px from its border.
-inline bool inside_image(const CameraIntrinsics& K, const Eigen::Vector3f& p, float margin) {
-  const float u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
-  return u > margin && v > margin && u < static_cast<float>(K.width) - margin &&
-         v < static_cast<float>(K.height) - margin;
-}
 
 }  // namespace modelling
 }  // namespace stairguide
