@@ -154,9 +154,51 @@ class FloorlessStairs {
     int stride = 1;                       ///< points per sample point (largest over its regions)
   };
 
+  /// The stack's direction and size after the direction phase.
+  struct StackDirection {
+    int dir = 0;  ///< +1 ascending, -1 descending, 0 undecided (no staircase)
+    int n = 0;    ///< stacked levels (the floor beside a stairwell taken out)
+  };
+  /// The stack's heights fitted against the stair index.
+  struct StackFit {
+    float level0 = 0.f;  ///< up . p of the virtual level 0 (camera frame), m
+    float riser = 0.f;   ///< m
+  };
+
+  // ---- phases (run's order; see the file comment's steps) ----
+  /// Up (floorless_up.cpp, step 1): the vertical from the largest family of plausible horizontal
+  /// planes; false when there is none.
   bool find_up(const SceneResult& scene);
+  /// Levels (floorless_stack.cpp, step 2): the family grouped by height and connectivity into
+  /// nodes_, ordered by height in order_.
   void build_nodes(const SceneResult& scene);
+  /// Stack (step 3): the longest chain of levels one riser apart, each connected to the one below
+  /// and rising by the same riser, into chain_ (lowest first); trace_.stacked, level_heights.
+  void build_stack();
+  /// Direction (step 4): every pair of levels must rise away from the camera (ascending) or
+  /// towards it (descending), one tie allowed. At the top of a descent seen cold, a top level a
+  /// chest camera's height below the camera and farther than the tread below it is the floor
+  /// beside the stairwell: taken out of the stack (trace_.floor_beside), descending.
+  StackDirection stack_direction();
+  /// Model (step 5): chain_ in stair order, its heights fitted against the index; the virtual
+  /// level 0 sits where that line meets index 0, so it adds nothing to modelling's riser fit.
+  StackFit fit_stack_heights(int dir, int n);
+  /// Cold start (floorless_cold.cpp): nothing remembered. The user's floor seen outside the stack
+  /// anchors it (run_anchored); two levels going down against a riser facing the user are refused;
+  /// otherwise the stack is modelled and decide_first_level says what its first level is.
+  void run_cold(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, const StackFit& fit,
+                StairResult& out);
+  /// Cold start, the first seen level cut by the image border at its near side: the floor (deeper
+  /// than the tread plus slack, or where a first tread would put the user's floor outside a chest
+  /// camera's height range), a step (the camera outside that range above it), or, from a wearer's
+  /// rig, modelled on it as the floor with its count unknown (`without_floor`); else kNoFirstStep.
+  void decide_first_level(const SceneResult& scene, const CameraIntrinsics* K, int dir, StairResult& out);
+
+  // ---- helpers ----
   void add_to_node(const SceneResult& scene, int region, Node& node) const;
+  /// Merges the nodes first..used-1 of one height cluster while any two are connected; returns
+  /// the new end of the used nodes.
+  std::size_t merge_connected_nodes(std::size_t first, std::size_t used);
   bool connected(const Node& a, const Node& b) const;
   float near_distance(const Node& n);
   /// Positions along z_S of the risers facing the user, by band (k: between levels k-1 and k;
@@ -168,8 +210,8 @@ class FloorlessStairs {
   bool edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const;
   /// The same for the line across level k at `z` along z_S.
   bool line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y, float z) const;
-  /// Anchored to the floor `camera_height` below the camera (remembered or seen; see the file
-  /// comment); `level0` is the stack's fitted level 0.
+  /// Anchoring (floorless_anchor.cpp): the stack placed from the floor `camera_height` below the
+  /// camera (remembered or seen; see the file comment); `level0` is the stack's fitted level 0.
   void run_anchored(const SceneResult& scene, const CameraIntrinsics* K, int dir, float riser, float level0,
                     float camera_height, StairResult& out);
   /// True when an upright region of the input scene stands between heights h_lo < h_hi (up . p,
@@ -187,6 +229,15 @@ class FloorlessStairs {
   static void add_hidden_steps(StairResult& out, int dir, int hidden);
   /// Tread and origin from the edges seen inside the image and the risers; validation again.
   void refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+  /// The step edges seen inside the image (k, position along z_S) into edge_k_, edge_e_: a riser
+  /// facing the user (plus the nosing measured where both agree) or a tread edge not on the image
+  /// border (trace_.edges_seen).
+  void collect_seen_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+  /// Tread from the seen edges by consensus (out.tread_m) and the origin's `shift` along z_S;
+  /// false, with kInconsistentEdges, when fewer than two thirds of the edges agree.
+  bool fit_seen_edges(int dir, StairResult& out, float& shift) const;
+  /// Moves the origin `shift` along z_S, and the levels' edges and extents with it.
+  static void shift_origin(int n, float shift, StairResult& out);
 
   ClassificationConfig cls_;
   StairDetectionConfig det_;
