@@ -160,6 +160,30 @@ class Segmentation {
   };
   void backproject(const RgbdFrame& frame);
   void cell_pass(std::vector<Grow>& grows);
+  /// Cell pass, its phases: the cell grid (cell of each column and row, the coordinate sums of a
+  /// full cell); each cell's moments and planarity test (planar cells into cells_); region growing
+  /// over the cell grid; the pixels of the region cells; and the pixels of each other cell beside
+  /// regions, handed to the neighbouring region whose plane fits them best.
+  void cell_grid(int cs);
+  void cell_moments(int cs);
+  /// cell_moments four cells of row `cv` at a time (SSE2); returns the first cell column left to do.
+  int cell_row_simd(int cv, int cs);
+  float cell_first_w(int cu, int cv, int cs) const;
+  void cell_finish(int cu, int cv, int cs, float w0, float n, float Sw, float Suw, float Svw, float Sww);
+  void grow_cells(std::vector<Grow>& grows);
+  void label_cell_pixels(int cs);
+  /// The regions around one cell that its pixels may join, with their planes' coefficients.
+  struct CellCands {
+    int cand[8];
+    float pa[8], pb[8], pc[8];
+    int lab_of[9];
+    int nk = 0;
+  };
+  void refine_cell(std::vector<Grow>& grows, int c, int cs);
+  /// Each pixel of row `v` of the cell at (u0, v0): its best candidate (cell_sel_) and label.
+  void select_cell_row(const CellCands& k, int v, int u0, int v0, int cs);
+  /// Each candidate's moments take its pixels of the cell, in raster order.
+  void add_cell_pixels(std::vector<Grow>& grows, const CellCands& k, int u0, int v0, int cs);
   void seed_pass(int cell, std::vector<Grow>& grows);
   /// Grows a region from `seed_pixels` (g.plane, g.dir set). Returns true when the region was
   /// grown with a fixed normal its pixels reject (it is then released, g.count == 0).
@@ -271,6 +295,9 @@ class Segmentation {
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
   std::vector<std::uint16_t> cell_valid_;  // cell pass: pixels with a reading per cell
+  int cell_need_ = 0;                      // cell pass: pixels with a reading a planar cell needs
+  float cell_limit_ = 0.f;                 // cell pass: residual limit of a planar cell (1/m)
+  float cell_full_[5] = {0, 0, 0, 0, 0};   // cell pass: Su, Sv, Suu, Suv, Svv over a full cell
   std::vector<int> first_kept_;            // finalize: first point column at or after each column
   std::vector<std::uint8_t> stride_keep_;  // extract_clusters: columns, then rows, that keep points
   std::vector<int> cell_pix_;              // cell pass: one candidate's pixels in a cell, then k / cs
