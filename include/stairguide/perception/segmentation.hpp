@@ -213,6 +213,12 @@ class Segmentation {
   /// Splits regions that straddle a crease between two dominant directions (a tread and its
   /// riser within one cell row, at range) along the crease line.
   void split_creases(std::vector<Grow>& grows);
+  /// split_creases' candidates (split_cands_): strips one cell row tall whose plane is a blend of
+  /// two dominant directions, with the (at most two) direction pairs and an image box holding them.
+  void find_crease_candidates(const std::vector<Grow>& grows);
+  /// Splits candidate `cd` along the crease line where that lowers the residual enough.
+  struct SplitCand;
+  void split_crease(std::vector<Grow>& grows, const SplitCand& cd);
   /// Splits off a band of rows at the top border of the view that lies on another dominant
   /// direction than the rest of its region (a tread sliver above its riser).
   void split_border_bands(std::vector<Grow>& grows);
@@ -243,6 +249,14 @@ class Segmentation {
   void drop_curved_tiles(std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
   void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
+  /// finalize's phases: which grown regions survive (their compact ids in order_, planes in
+  /// fits_; returns how many); the pooled pixel and point buffers handed out, biggest to the
+  /// biggest; one raster pass over the labels (pixels, points, sums); each region's description.
+  std::size_t keep_regions(std::vector<Grow>& grows);
+  void hand_out_buffers(const std::vector<Grow>& grows, std::vector<PlaneRegion>& regions, std::size_t out);
+  void raster_regions(std::vector<PlaneRegion>& regions, std::size_t out);
+  /// Centroid, area, principal rectangle, extent and curvature of region `id`.
+  void describe_region(PlaneRegion& R, std::size_t id, float area_k);
   void extract_clusters(std::vector<ObstacleCluster>& clusters);
   /// Inlier tolerance on the perpendicular distance (m) at depth z from a plane at distance d.
   /// v = p / width without a hardware division (exact for images up to 4096 wide).

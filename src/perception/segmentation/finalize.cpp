@@ -26,6 +26,14 @@ inline int run_end(const int* lab, int u, int end) {
 }  // namespace
 
 void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions) {
+  const std::size_t out = keep_regions(grows);
+  hand_out_buffers(grows, regions, out);
+  raster_regions(regions, out);
+  const float area_k = 1.f / (K_.fx * K_.fy);
+  for (std::size_t id = 0; id < out; ++id) describe_region(regions[id], id, area_k);
+}
+
+std::size_t Segmentation::keep_regions(std::vector<Grow>& grows) {
   const int n = static_cast<int>(grows.size());
   // Which grown regions survive, and their compact ids. Every pixel was accepted within the noise
   // of its region's plane; the planarity check is that the final plane's residual is noise-like
@@ -64,6 +72,12 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
     fits_[out] = f;
     map[r] = static_cast<int>(out++);
   }
+  return out;
+}
+
+void Segmentation::hand_out_buffers(const std::vector<Grow>& grows, std::vector<PlaneRegion>& regions, std::size_t out) {
+  const int n = static_cast<int>(grows.size());
+  const std::vector<int>& map = order_;
   // The pixel and point buffers of the last frame's regions are pooled and handed out again,
   // biggest to the biggest region: a region's size changes from frame to frame, and growing
   // buffers of 10^5 entries anew each frame cost more than the raster pass filling them.
@@ -102,6 +116,10 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
     // resize per run was a library call per run, and real frames have ten thousand runs.
     R.pixels.resize(cnt);
   }
+}
+
+void Segmentation::raster_regions(std::vector<PlaneRegion>& regions, std::size_t out) {
+  const std::vector<int>& map = order_;
   std::vector<int>& filled = cid_;  // pixels written per region
   filled.assign(out, 0);
   // One raster pass: pixels, points, centroid, footprint area, moments for the principal axes.
@@ -159,59 +177,59 @@ void Segmentation::finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& 
       u = e;
     }
   }
-  const float area_k = 1.f / (K_.fx * K_.fy);
-  for (std::size_t id = 0; id < out; ++id) {
-    PlaneRegion& R = regions[id];
-    R.pixels.resize(static_cast<std::size_t>(filled[id]));
-    RegionAcc& A = acc_[id];
-    const PlaneFit& f = fits_[id];
-    const int cnt = static_cast<int>(R.pixels.size());
-    R.id = static_cast<int>(id);
-    R.normal = f.normal;
-    R.offset = f.d;
-    R.pixel_count = cnt;
-    if (R.points.empty()) {
-      // A region thinner than the subsample grid: fall back on its pixels.
-      for (int p : R.pixels) {
-        const int v = row_of(p), u = p - v * W_;
-        const float z = z_[p];
-        R.points.emplace_back(un_[u] * z, vn_[v] * z, z);
-        A.z3 += double(z) * z * z;
-        A.m.add(un_[u] * z, vn_[v] * z, z);
-      }
+}
+
+void Segmentation::describe_region(PlaneRegion& R, std::size_t id, float area_k) {
+  const std::vector<int>& filled = cid_;
+  R.pixels.resize(static_cast<std::size_t>(filled[id]));
+  RegionAcc& A = acc_[id];
+  const PlaneFit& f = fits_[id];
+  const int cnt = static_cast<int>(R.pixels.size());
+  R.id = static_cast<int>(id);
+  R.normal = f.normal;
+  R.offset = f.d;
+  R.pixel_count = cnt;
+  if (R.points.empty()) {
+    // A region thinner than the subsample grid: fall back on its pixels.
+    for (int p : R.pixels) {
+      const int v = row_of(p), u = p - v * W_;
+      const float z = z_[p];
+      R.points.emplace_back(un_[u] * z, vn_[v] * z, z);
+      A.z3 += double(z) * z * z;
+      A.m.add(un_[u] * z, vn_[v] * z, z);
     }
-    const double np = std::max<double>(1.0, static_cast<double>(R.points.size()));
-    R.centroid = Eigen::Vector3f(static_cast<float>(A.m.sx / np), static_cast<float>(A.m.sy / np),
-                                 static_cast<float>(A.m.sz / np));
-    R.cls = RegionClass::kUnclassified;
-    R.height = std::numeric_limits<float>::quiet_NaN();
-    // Footprint of one pixel on the plane: z^3 / (fx fy |n.p|), and n.p = -d on the plane.
-    R.area = static_cast<float>(A.z3 * (static_cast<double>(cnt) / np) * area_k / std::max(std::fabs(f.d), 0.01f));
-    const PlaneFit fu = fit_plane_pca(A.m);
-    Eigen::Vector3f a1 = fu.ok ? Eigen::Vector3f(fu.eigenvectors.col(2)) : f.normal.unitOrthogonal();
-    R.curvature = fu.ok ? fu.eigenvalues[0] / std::max(fu.eigenvalues.sum(), 1e-12f) : 0.f;
-    a1 = a1 - a1.dot(f.normal) * f.normal;
-    if (a1.norm() < 1e-3f) a1 = f.normal.unitOrthogonal();
-    a1.normalize();
-    const Eigen::Vector3f a2 = f.normal.cross(a1).normalized();
-    float mn1 = 1e9f, mx1 = -1e9f, mn2 = 1e9f, mx2 = -1e9f;
-    for (const Eigen::Vector3f& q : R.points) {
-      const Eigen::Vector3f dq = q - R.centroid;
-      const float s1 = dq.dot(a1), s2 = dq.dot(a2);
-      mn1 = std::min(mn1, s1);
-      mx1 = std::max(mx1, s1);
-      mn2 = std::min(mn2, s2);
-      mx2 = std::max(mx2, s2);
-    }
-    if (R.points.empty()) mn1 = mx1 = mn2 = mx2 = 0.f;
-    R.rect_axis_major = a1;
-    R.rect_axis_minor = a2;
-    R.rect_length_major = mx1 - mn1;
-    R.rect_length_minor = mx2 - mn2;
-    R.rect_center = R.centroid + a1 * (0.5f * (mn1 + mx1)) + a2 * (0.5f * (mn2 + mx2));
-    const float rect_area = R.rect_length_major * R.rect_length_minor;
-    R.hull_extent = rect_area > 0.f ? std::min(1.f, R.area / rect_area) : 0.f;
   }
+  const double np = std::max<double>(1.0, static_cast<double>(R.points.size()));
+  R.centroid = Eigen::Vector3f(static_cast<float>(A.m.sx / np), static_cast<float>(A.m.sy / np),
+                               static_cast<float>(A.m.sz / np));
+  R.cls = RegionClass::kUnclassified;
+  R.height = std::numeric_limits<float>::quiet_NaN();
+  // Footprint of one pixel on the plane: z^3 / (fx fy |n.p|), and n.p = -d on the plane.
+  R.area = static_cast<float>(A.z3 * (static_cast<double>(cnt) / np) * area_k / std::max(std::fabs(f.d), 0.01f));
+  const PlaneFit fu = fit_plane_pca(A.m);
+  Eigen::Vector3f a1 = fu.ok ? Eigen::Vector3f(fu.eigenvectors.col(2)) : f.normal.unitOrthogonal();
+  R.curvature = fu.ok ? fu.eigenvalues[0] / std::max(fu.eigenvalues.sum(), 1e-12f) : 0.f;
+  a1 = a1 - a1.dot(f.normal) * f.normal;
+  if (a1.norm() < 1e-3f) a1 = f.normal.unitOrthogonal();
+  a1.normalize();
+  const Eigen::Vector3f a2 = f.normal.cross(a1).normalized();
+  float mn1 = 1e9f, mx1 = -1e9f, mn2 = 1e9f, mx2 = -1e9f;
+  for (const Eigen::Vector3f& q : R.points) {
+    const Eigen::Vector3f dq = q - R.centroid;
+    const float s1 = dq.dot(a1), s2 = dq.dot(a2);
+    mn1 = std::min(mn1, s1);
+    mx1 = std::max(mx1, s1);
+    mn2 = std::min(mn2, s2);
+    mx2 = std::max(mx2, s2);
+  }
+  if (R.points.empty()) mn1 = mx1 = mn2 = mx2 = 0.f;
+  R.rect_axis_major = a1;
+  R.rect_axis_minor = a2;
+  R.rect_length_major = mx1 - mn1;
+  R.rect_length_minor = mx2 - mn2;
+  R.rect_center = R.centroid + a1 * (0.5f * (mn1 + mx1)) + a2 * (0.5f * (mn2 + mx2));
+  const float rect_area = R.rect_length_major * R.rect_length_minor;
+  R.hull_extent = rect_area > 0.f ? std::min(1.f, R.area / rect_area) : 0.f;
 }
 
 }  // namespace stairguide

@@ -55,11 +55,15 @@ void Segmentation::split_creases(std::vector<Grow>& grows) {
   // Such a strip is split along the crease line of the two dominant directions whose blend it is:
   // the sweep across that line picks the split that best explains each side by one direction.
   if (dirs_.size() < 2) return;
+  find_crease_candidates(grows);
+  for (const SplitCand& cd : split_cands_) split_crease(grows, cd);
+}
+
+void Segmentation::find_crease_candidates(const std::vector<Grow>& grows) {
   const int cs = std::max(2, cfg_.cell_size_px);
   const float cos_own = std::cos(cfg_.region_angle);
   const float cos_pair = std::cos(60.f * 3.14159265f / 180.f);
   const float sin_line = std::sin(10.f * 3.14159265f / 180.f);
-  const float limit = 0.5f * tolerance_w();
   const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
   const int ng = static_cast<int>(grows.size());
   const int nd = static_cast<int>(dirs_.size());
@@ -119,82 +123,85 @@ void Segmentation::split_creases(std::vector<Grow>& grows) {
     c.u0 = std::max(0, static_cast<int>(uc - hu) - cs), c.u1 = std::min(W_ - 1, static_cast<int>(uc + hu) + cs);
     cands.push_back(c);
   }
+}
+
+void Segmentation::split_crease(std::vector<Grow>& grows, const SplitCand& cd) {
+  const float limit = 0.5f * tolerance_w();
+  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
   std::vector<int>& pix = split_pixels_;
   std::vector<int>& side_a = split_side_;
-  for (const Cand& cd : cands) {
-    const int r = cd.r;
-    pix.clear();
-    for (int v = cd.v0; v <= cd.v1; ++v) {
-      const int* lab = &label_[static_cast<std::size_t>(v) * W_];
-      for (int u = cd.u0; u <= cd.u1; ++u)
-        if (lab[u] == r) pix.push_back(v * W_ + u);
-    }
-    if (static_cast<int>(pix.size()) != grows[r].count) continue;  // not all inside the box: leave it
-    const int p0 = 0, p1 = static_cast<int>(pix.size());
-    const InvDepthMoments m = grows[r].m;
-    const PlaneFit joint = fit_plane(m);
-    if (!joint.ok) continue;
-    const double ssr_joint = fit_ssr(joint, m);
-    double best = ssr_joint;
-    int best_pair = -1, best_k = 0, best_o = 0;
-    float best_eu = 0, best_ev = 0, best_smin = 0;
-    const Eigen::Vector3f P = grows[r].plane.mean;
-    for (int pi = 0; pi < cd.np; ++pi) {
-      const Eigen::Vector3f t = dirs_[cd.pairs[pi][0]].cross(dirs_[cd.pairs[pi][1]]).normalized();
-      // Image direction of the crease line through the strip's centre, in pixels.
-      float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
-      const float ln = std::sqrt(du * du + dv * dv);
-      if (!(ln > 1e-9f)) continue;
-      du /= ln, dv /= ln;
-      const float eu = -dv, ev = du;  // across the line
-      float smin = 1e30f, smax = -1e30f;
-      for (int k = p0; k < p1; ++k) {
-        const int p = pix[k], v = row_of(p), u = p - v * W_;
-        const float s = eu * u + ev * v;
-        smin = std::min(smin, s), smax = std::max(smax, s);
-      }
-      const int nb = static_cast<int>(smax - smin) + 1;
-      if (nb < 2 || nb > 4096) continue;
-      bins_.assign(static_cast<std::size_t>(nb), InvDepthMoments{});
-      for (int k = p0; k < p1; ++k) {
-        const int p = pix[k], v = row_of(p), u = p - v * W_;
-        bins_[static_cast<std::size_t>(eu * u + ev * v - smin)].add(un_[u], vn_[v], w_[p]);
-      }
-      InvDepthMoments A;
-      for (int k = 1; k < nb; ++k) {
-        A.add(bins_[static_cast<std::size_t>(k - 1)]);
-        if (A.n < kSplitMinSide || m.n - A.n < kSplitMinSide) continue;
-        const InvDepthMoments B = moments_minus(m, A);
-        for (int o = 0; o < 2; ++o) {
-          const PlaneFit fa = fit_plane_fixed_normal(A, dirs_[cd.pairs[pi][o]]);
-          if (!fa.ok || fa.rms_w > limit) continue;
-          const PlaneFit fb = fit_plane_fixed_normal(B, dirs_[cd.pairs[pi][1 - o]]);
-          if (!fb.ok || fb.rms_w > limit) continue;
-          const double ssr = fit_ssr(fa, A) + fit_ssr(fb, B);
-          if (ssr < best) best = ssr, best_pair = pi, best_k = k, best_o = o, best_eu = eu, best_ev = ev, best_smin = smin;
-        }
-      }
-    }
-    if (best_pair < 0 || (ssr_joint - best) < kSplitGain * sig2) continue;
-    // Side A (sweep bins below best_k) and side B; the bigger side keeps the region's id.
-    const int da = cd.pairs[best_pair][best_o], db = cd.pairs[best_pair][1 - best_o];
-    int na = 0;
-    for (int k = p0; k < p1; ++k) {
-      const int p = pix[k], v = row_of(p), u = p - v * W_;
-      na += static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k;
-    }
-    const bool move_a = 2 * na <= p1 - p0;
-    side_a.clear();
-    for (int k = p0; k < p1; ++k) {
-      const int p = pix[k], v = row_of(p), u = p - v * W_;
-      if ((static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k) == move_a) side_a.push_back(p);
-    }
-    const int keep_dir = move_a ? db : da, move_dir = move_a ? da : db;
-    if (!move_to_new_region(grows, r, side_a, move_dir)) continue;
-    const PlaneFit fk = fit_plane_fixed_normal(grows[r].m, dirs_[keep_dir]);
-    if (fk.ok) grows[r].plane = fk, grows[r].dir = keep_dir;
-    ++stats_.crease_splits;
+  const int r = cd.r;
+  pix.clear();
+  for (int v = cd.v0; v <= cd.v1; ++v) {
+    const int* lab = &label_[static_cast<std::size_t>(v) * W_];
+    for (int u = cd.u0; u <= cd.u1; ++u)
+      if (lab[u] == r) pix.push_back(v * W_ + u);
   }
+  if (static_cast<int>(pix.size()) != grows[r].count) return;  // not all inside the box: leave it
+  const int p0 = 0, p1 = static_cast<int>(pix.size());
+  const InvDepthMoments m = grows[r].m;
+  const PlaneFit joint = fit_plane(m);
+  if (!joint.ok) return;
+  const double ssr_joint = fit_ssr(joint, m);
+  double best = ssr_joint;
+  int best_pair = -1, best_k = 0, best_o = 0;
+  float best_eu = 0, best_ev = 0, best_smin = 0;
+  const Eigen::Vector3f P = grows[r].plane.mean;
+  for (int pi = 0; pi < cd.np; ++pi) {
+    const Eigen::Vector3f t = dirs_[cd.pairs[pi][0]].cross(dirs_[cd.pairs[pi][1]]).normalized();
+    // Image direction of the crease line through the strip's centre, in pixels.
+    float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
+    const float ln = std::sqrt(du * du + dv * dv);
+    if (!(ln > 1e-9f)) continue;
+    du /= ln, dv /= ln;
+    const float eu = -dv, ev = du;  // across the line
+    float smin = 1e30f, smax = -1e30f;
+    for (int k = p0; k < p1; ++k) {
+      const int p = pix[k], v = row_of(p), u = p - v * W_;
+      const float s = eu * u + ev * v;
+      smin = std::min(smin, s), smax = std::max(smax, s);
+    }
+    const int nb = static_cast<int>(smax - smin) + 1;
+    if (nb < 2 || nb > 4096) continue;
+    bins_.assign(static_cast<std::size_t>(nb), InvDepthMoments{});
+    for (int k = p0; k < p1; ++k) {
+      const int p = pix[k], v = row_of(p), u = p - v * W_;
+      bins_[static_cast<std::size_t>(eu * u + ev * v - smin)].add(un_[u], vn_[v], w_[p]);
+    }
+    InvDepthMoments A;
+    for (int k = 1; k < nb; ++k) {
+      A.add(bins_[static_cast<std::size_t>(k - 1)]);
+      if (A.n < kSplitMinSide || m.n - A.n < kSplitMinSide) continue;
+      const InvDepthMoments B = moments_minus(m, A);
+      for (int o = 0; o < 2; ++o) {
+        const PlaneFit fa = fit_plane_fixed_normal(A, dirs_[cd.pairs[pi][o]]);
+        if (!fa.ok || fa.rms_w > limit) continue;
+        const PlaneFit fb = fit_plane_fixed_normal(B, dirs_[cd.pairs[pi][1 - o]]);
+        if (!fb.ok || fb.rms_w > limit) continue;
+        const double ssr = fit_ssr(fa, A) + fit_ssr(fb, B);
+        if (ssr < best) best = ssr, best_pair = pi, best_k = k, best_o = o, best_eu = eu, best_ev = ev, best_smin = smin;
+      }
+    }
+  }
+  if (best_pair < 0 || (ssr_joint - best) < kSplitGain * sig2) return;
+  // Side A (sweep bins below best_k) and side B; the bigger side keeps the region's id.
+  const int da = cd.pairs[best_pair][best_o], db = cd.pairs[best_pair][1 - best_o];
+  int na = 0;
+  for (int k = p0; k < p1; ++k) {
+    const int p = pix[k], v = row_of(p), u = p - v * W_;
+    na += static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k;
+  }
+  const bool move_a = 2 * na <= p1 - p0;
+  side_a.clear();
+  for (int k = p0; k < p1; ++k) {
+    const int p = pix[k], v = row_of(p), u = p - v * W_;
+    if ((static_cast<int>(best_eu * u + best_ev * v - best_smin) < best_k) == move_a) side_a.push_back(p);
+  }
+  const int keep_dir = move_a ? db : da, move_dir = move_a ? da : db;
+  if (!move_to_new_region(grows, r, side_a, move_dir)) return;
+  const PlaneFit fk = fit_plane_fixed_normal(grows[r].m, dirs_[keep_dir]);
+  if (fk.ok) grows[r].plane = fk, grows[r].dir = keep_dir;
+  ++stats_.crease_splits;
 }
 
 void Segmentation::split_border_bands(std::vector<Grow>& grows) {
