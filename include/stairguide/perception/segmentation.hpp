@@ -225,6 +225,12 @@ class Segmentation {
   /// The same below an occlusion edge (no readings above): a tread's visible sliver between its
   /// riser and the shadow of the next nosing, taken by the riser's region.
   void split_edge_bands(std::vector<Grow>& grows);
+  /// split_edge_bands' candidate regions (live_, their slots in cid_): planar, parallel to one
+  /// dominant direction and square to another. False: none.
+  bool edge_band_candidates(const std::vector<Grow>& grows);
+  /// split_edge_bands' tops of columns under a hole (order_) and the residual sums per candidate
+  /// and row below them (edge_acc_).
+  void find_edge_tops(const std::vector<Grow>& grows);
   /// The band of a region's first rows (from the top border or below an occlusion edge) to split
   /// off onto a dominant direction: rows 0 and dir -1 when none explains the region better.
   /// `bins` holds the moments of the region's pixels per row (or per sweep step) from the border,
@@ -246,8 +252,20 @@ class Segmentation {
   /// Returns false (nothing changed) when the new region's fit fails.
   bool move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir);
   void merge_regions(std::vector<Grow>& grows);
+  /// merge_regions' phases: the live regions (live_, cid_), which of them touch (mask_) and the
+  /// seam samples (seams_), false when there is nothing to merge; the merges of touching pairs
+  /// (union-find in `parent`); the labels relabelled to their roots.
+  bool find_seams(const std::vector<Grow>& grows);
+  void merge_pairs(std::vector<Grow>& grows, std::vector<int>& parent);
+  void relabel_merged(const std::vector<int>& parent);
   void drop_curved_tiles(std::vector<Grow>& grows);
+  /// drop_curved_tiles' phases: the live regions, their areas and which are candidate facets
+  /// (returns how many); the seam contacts of each pair, and how many of them are smooth.
+  int curved_candidates(const std::vector<Grow>& grows);
+  void seam_contacts(const std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
+  /// refine_borders' first layer: the pixels with a neighbour of another region (seed_pixels_).
+  void find_border_pixels();
   void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
   /// finalize's phases: which grown regions survive (their compact ids in order_, planes in
   /// fits_; returns how many); the pooled pixel and point buffers handed out, biggest to the

@@ -16,6 +16,17 @@ int find_root(std::vector<int>& parent, int a) {
 }  // namespace
 
 void Segmentation::merge_regions(std::vector<Grow>& grows) {
+  if (!find_seams(grows)) return;
+  const int n = static_cast<int>(grows.size());
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  merge_pairs(grows, parent);
+  if (stats_.regions_merged == 0) return;
+  for (int r = 0; r < n; ++r) parent[r] = find_root(parent, r);
+  relabel_merged(parent);
+}
+
+bool Segmentation::find_seams(const std::vector<Grow>& grows) {
   const int n = static_cast<int>(grows.size());
   // Dropped seeds leave empty slots (often most of them on cluttered real frames): the pair
   // tables below are over the live regions only.
@@ -27,7 +38,7 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
     if (grows[r].count > 0) cid[r] = static_cast<int>(live.size()), live.push_back(r);
   const int m = static_cast<int>(live.size());
   seams_.clear();
-  if (m < 2 || m > 4096) return;
+  if (m < 2 || m > 4096) return false;
   std::vector<std::uint8_t>& adj = mask_;
   adj.assign(static_cast<std::size_t>(m) * m, 0);
   // The seam samples (pixel pairs of two regions) are kept for drop_curved_tiles.
@@ -75,8 +86,13 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
       }
     }
   }
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
+  return true;
+}
+
+void Segmentation::merge_pairs(std::vector<Grow>& grows, std::vector<int>& parent) {
+  const std::vector<int>& live = live_;
+  const int m = static_cast<int>(live.size());
+  const std::vector<std::uint8_t>& adj = mask_;
   const float cos_max = std::cos(2.f * cfg_.region_angle);
   for (int ca = 0; ca < m; ++ca) {
     for (int cb = ca + 1; cb < m; ++cb) {
@@ -115,8 +131,11 @@ void Segmentation::merge_regions(std::vector<Grow>& grows) {
       ++stats_.regions_merged;
     }
   }
-  if (stats_.regions_merged == 0) return;
-  for (int r = 0; r < n; ++r) parent[r] = find_root(parent, r);
+}
+
+void Segmentation::relabel_merged(const std::vector<int>& parent) {
+  const int n = static_cast<int>(parent.size());
+  const int cs = std::max(2, cfg_.cell_size_px);
   // Relabel. The valid pixels of a region cell all carry the cell's label (the passes after the
   // cell pass take only free pixels): a cell of an unmerged region is skipped whole. Elsewhere a
   // table lookup per pixel, without a branch (-1 maps to itself): labels change every few pixels
@@ -153,69 +172,12 @@ void Segmentation::drop_curved_tiles(std::vector<Grow>& grows) {
   // planes of the built world meet at creases of about 90 degrees (tread/riser, wall/floor) or
   // at occlusion edges (a depth jump).
   if (!(cfg_.curved_tile_max_area > 0.f)) return;
-  const int ng = static_cast<int>(grows.size());
-  std::vector<int>& cid = cid_;  // grown region -> index among the live ones (-1: empty slot)
-  std::vector<int>& live = live_;
-  cid.assign(static_cast<std::size_t>(ng), -1);
-  live.clear();
-  for (int r = 0; r < ng; ++r)
-    if (grows[r].count > 0 && grows[r].plane.ok) cid[r] = static_cast<int>(live.size()), live.push_back(r);
-  const int n = static_cast<int>(live.size());
-  if (n < 2 || n > 4096) return;
-  // Candidates: small regions not parallel to a big one (treads, risers, floor and wall pieces
-  // are parallel to the floor or a wall; a facet of a curve generally is not). The directions
-  // come from the big regions here, not from dirs_: facets of a near person pass the dominant
-  // size in pixels.
-  std::vector<std::uint8_t>& cand = cell_planar_;  // no longer needed after the cell pass
-  cand.assign(static_cast<std::size_t>(n), 0);
-  std::vector<float>& area = area_;
-  area.assign(static_cast<std::size_t>(n), 0.f);
-  const float area_k = 1.f / (K_.fx * K_.fy);
-  std::vector<Eigen::Vector3f>& big = big_dirs_;
-  big.clear();
-  const float par = std::cos(5.f * 3.14159265f / 180.f);
-  for (int r = 0; r < n; ++r) {
-    const Grow& g = grows[live[r]];
-    // Pixel footprint on the plane z^3 / (fx fy d), at the region's mean pixel.
-    const float z = g.plane.mean.z();
-    area[r] = static_cast<float>(g.count) * z * z * z * area_k / std::max(g.plane.d, 0.01f);
-    if (area[r] < cfg_.curved_tile_max_area && g.dir < 0) {
-      cand[r] = 1;
-      continue;
-    }
-    bool dup = false;
-    for (const Eigen::Vector3f& d : big) dup |= d.dot(g.plane.normal) > par;
-    if (!dup && big.size() < 32) big.push_back(g.plane.normal);
-  }
-  int ncand = 0;
-  for (int r = 0; r < n; ++r) {
-    if (!cand[r]) continue;
-    for (const Eigen::Vector3f& d : big) cand[r] &= d.dot(grows[live[r]].plane.normal) <= par;
-    ncand += cand[r];
-  }
-  if (ncand == 0) return;
-  const std::size_t nn = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-  contact_.assign(nn, 0);
-  smooth_.assign(nn, 0);
-  const float tw = tolerance_w();
-  // The seam samples of merge_regions (pixel pairs of two regions, labels now merged).
-  for (std::size_t i = 0; i + 1 < seams_.size(); i += 2) {
-    const int p = seams_[i], q = seams_[i + 1];
-    const int la = label_[p], lb = label_[q];
-    if (la == lb || la < 0 || lb < 0) continue;
-    const int a = cid[la], b = cid[lb];
-    if (a < 0 || b < 0 || !(cand[a] | cand[b])) continue;
-    const std::size_t k = static_cast<std::size_t>(std::min(a, b)) * n + static_cast<std::size_t>(std::max(a, b));
-    if (contact_[k] == 0xFFFF) continue;
-    ++contact_[k];
-    // Both planes pass through the seam: no depth jump between the two regions there.
-    const PlaneFit& pa = grows[la].plane;
-    const PlaneFit& pb = grows[lb].plane;
-    const int vp = row_of(p), up = p - vp * W_, vq = row_of(q), uq = q - vq * W_;
-    const float ra = w_[q] - (pa.a * un_[uq] + pa.b * vn_[vq] + pa.c);
-    const float rb = w_[p] - (pb.a * un_[up] + pb.b * vn_[vp] + pb.c);
-    smooth_[k] += std::fabs(ra) <= tw && std::fabs(rb) <= tw;
-  }
+  if (curved_candidates(grows) == 0) return;
+  const int n = static_cast<int>(live_.size());
+  const std::vector<int>& live = live_;
+  const std::vector<std::uint8_t>& cand = cell_planar_;
+  const std::vector<float>& area = area_;
+  seam_contacts(grows);
   // A candidate bending into another candidate, or into two regions, is a facet: a lone tilted
   // patch against one big plane (a rounded nosing, a sign) is kept. Only neighbours of a facet's
   // size count (curved_facet_size_ratio): with the real-like noise (correlated over 2 and 10 px), a
@@ -259,12 +221,129 @@ void Segmentation::drop_curved_tiles(std::vector<Grow>& grows) {
   }
 }
 
+int Segmentation::curved_candidates(const std::vector<Grow>& grows) {
+  const int ng = static_cast<int>(grows.size());
+  std::vector<int>& cid = cid_;  // grown region -> index among the live ones (-1: empty slot)
+  std::vector<int>& live = live_;
+  cid.assign(static_cast<std::size_t>(ng), -1);
+  live.clear();
+  for (int r = 0; r < ng; ++r)
+    if (grows[r].count > 0 && grows[r].plane.ok) cid[r] = static_cast<int>(live.size()), live.push_back(r);
+  const int n = static_cast<int>(live.size());
+  if (n < 2 || n > 4096) return 0;
+  // Candidates: small regions not parallel to a big one (treads, risers, floor and wall pieces
+  // are parallel to the floor or a wall; a facet of a curve generally is not). The directions
+  // come from the big regions here, not from dirs_: facets of a near person pass the dominant
+  // size in pixels.
+  std::vector<std::uint8_t>& cand = cell_planar_;  // no longer needed after the cell pass
+  cand.assign(static_cast<std::size_t>(n), 0);
+  std::vector<float>& area = area_;
+  area.assign(static_cast<std::size_t>(n), 0.f);
+  const float area_k = 1.f / (K_.fx * K_.fy);
+  std::vector<Eigen::Vector3f>& big = big_dirs_;
+  big.clear();
+  const float par = std::cos(5.f * 3.14159265f / 180.f);
+  for (int r = 0; r < n; ++r) {
+    const Grow& g = grows[live[r]];
+    // Pixel footprint on the plane z^3 / (fx fy d), at the region's mean pixel.
+    const float z = g.plane.mean.z();
+    area[r] = static_cast<float>(g.count) * z * z * z * area_k / std::max(g.plane.d, 0.01f);
+    if (area[r] < cfg_.curved_tile_max_area && g.dir < 0) {
+      cand[r] = 1;
+      continue;
+    }
+    bool dup = false;
+    for (const Eigen::Vector3f& d : big) dup |= d.dot(g.plane.normal) > par;
+    if (!dup && big.size() < 32) big.push_back(g.plane.normal);
+  }
+  int ncand = 0;
+  for (int r = 0; r < n; ++r) {
+    if (!cand[r]) continue;
+    for (const Eigen::Vector3f& d : big) cand[r] &= d.dot(grows[live[r]].plane.normal) <= par;
+    ncand += cand[r];
+  }
+  return ncand;
+}
+
+void Segmentation::seam_contacts(const std::vector<Grow>& grows) {
+  const std::vector<int>& cid = cid_;
+  const int n = static_cast<int>(live_.size());
+  const std::vector<std::uint8_t>& cand = cell_planar_;
+  const std::size_t nn = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  contact_.assign(nn, 0);
+  smooth_.assign(nn, 0);
+  const float tw = tolerance_w();
+  // The seam samples of merge_regions (pixel pairs of two regions, labels now merged).
+  for (std::size_t i = 0; i + 1 < seams_.size(); i += 2) {
+    const int p = seams_[i], q = seams_[i + 1];
+    const int la = label_[p], lb = label_[q];
+    if (la == lb || la < 0 || lb < 0) continue;
+    const int a = cid[la], b = cid[lb];
+    if (a < 0 || b < 0 || !(cand[a] | cand[b])) continue;
+    const std::size_t k = static_cast<std::size_t>(std::min(a, b)) * n + static_cast<std::size_t>(std::max(a, b));
+    if (contact_[k] == 0xFFFF) continue;
+    ++contact_[k];
+    // Both planes pass through the seam: no depth jump between the two regions there.
+    const PlaneFit& pa = grows[la].plane;
+    const PlaneFit& pb = grows[lb].plane;
+    const int vp = row_of(p), up = p - vp * W_, vq = row_of(q), uq = q - vq * W_;
+    const float ra = w_[q] - (pa.a * un_[uq] + pa.b * vn_[vq] + pa.c);
+    const float rb = w_[p] - (pb.a * un_[up] + pb.b * vn_[vp] + pb.c);
+    smooth_[k] += std::fabs(ra) <= tw && std::fabs(rb) <= tw;
+  }
+}
+
 void Segmentation::refine_borders(std::vector<Grow>& grows) {
   // Pixels near the edge between two planes (a tread and its riser) are within the noise of both;
   // whichever region grew first took them, which biases its plane. Each border pixel goes to the
   // neighbouring region whose plane it fits best (CAPE-style refinement), layer by layer.
+  find_border_pixels();
   std::vector<int>& cur = seed_pixels_;
   std::vector<int>& nxt = next_;
+  const float kl = 1.41421356f * tolerance_w();
+  for (int iter = 0; iter < 8 && !cur.empty(); ++iter) {
+    nxt.clear();
+    for (int p : cur) {
+      const int a = label_[p];
+      if (a < 0 || grows[a].count <= 0) continue;  // dropped regions' pixels go to the clusters
+      const int v = row_of(p), u = p - v * W_;
+      const float wp = w_[p];
+      const PlaneFit& pa = grows[a].plane;
+      int best = a;
+      float best_res = std::fabs(wp - (pa.a * un_[u] + pa.b * vn_[v] + pa.c));
+      int nb[4], nu[4], nv[4];
+      int k = 0;
+      if (u > 0) nb[k] = p - 1, nu[k] = u - 1, nv[k++] = v;
+      if (u + 1 < W_) nb[k] = p + 1, nu[k] = u + 1, nv[k++] = v;
+      if (v > 0) nb[k] = p - W_, nu[k] = u, nv[k++] = v - 1;
+      if (v + 1 < H_) nb[k] = p + W_, nu[k] = u, nv[k++] = v + 1;
+      for (int i = 0; i < k; ++i) {
+        const int bl = label_[nb[i]];
+        if (bl < 0 || bl == a || bl == best || grows[bl].count == 0) continue;
+        const PlaneFit& pb = grows[bl].plane;
+        const float res = std::fabs(wp - (pb.a * un_[u] + pb.b * vn_[v] + pb.c));
+        if (res >= best_res || res > tolerance_w()) continue;
+        const float step = (wp - w_[nb[i]]) - (pb.a * (un_[u] - un_[nu[i]]) + pb.b * (vn_[v] - vn_[nv[i]]));
+        if (std::fabs(step) > kl) continue;
+        best = bl;
+        best_res = res;
+      }
+      if (best == a) continue;
+      label_[p] = best;
+      grows[a].m.sub(un_[u], vn_[v], wp);
+      grows[best].m.add(un_[u], vn_[v], wp);
+      --grows[a].count;
+      ++grows[best].count;
+      ++stats_.border_pixels_moved;
+      for (int i = 0; i < k; ++i)
+        if (label_[nb[i]] == a) nxt.push_back(nb[i]);
+    }
+    std::swap(cur, nxt);
+  }
+}
+
+void Segmentation::find_border_pixels() {
+  std::vector<int>& cur = seed_pixels_;
   cur.clear();
   // Edges between planes run through the cells that were not planar (whole planar cells went to
   // one region), and through the image margin outside the cell grid.
@@ -329,46 +408,6 @@ void Segmentation::refine_borders(std::vector<Grow>& grows) {
     if (++vr == cs) vr = 0, ++cv;
   }
   cur.assign(buf, buf + nb);
-  const float kl = 1.41421356f * tolerance_w();
-  for (int iter = 0; iter < 8 && !cur.empty(); ++iter) {
-    nxt.clear();
-    for (int p : cur) {
-      const int a = label_[p];
-      if (a < 0 || grows[a].count <= 0) continue;  // dropped regions' pixels go to the clusters
-      const int v = row_of(p), u = p - v * W_;
-      const float wp = w_[p];
-      const PlaneFit& pa = grows[a].plane;
-      int best = a;
-      float best_res = std::fabs(wp - (pa.a * un_[u] + pa.b * vn_[v] + pa.c));
-      int nb[4], nu[4], nv[4];
-      int k = 0;
-      if (u > 0) nb[k] = p - 1, nu[k] = u - 1, nv[k++] = v;
-      if (u + 1 < W_) nb[k] = p + 1, nu[k] = u + 1, nv[k++] = v;
-      if (v > 0) nb[k] = p - W_, nu[k] = u, nv[k++] = v - 1;
-      if (v + 1 < H_) nb[k] = p + W_, nu[k] = u, nv[k++] = v + 1;
-      for (int i = 0; i < k; ++i) {
-        const int bl = label_[nb[i]];
-        if (bl < 0 || bl == a || bl == best || grows[bl].count == 0) continue;
-        const PlaneFit& pb = grows[bl].plane;
-        const float res = std::fabs(wp - (pb.a * un_[u] + pb.b * vn_[v] + pb.c));
-        if (res >= best_res || res > tolerance_w()) continue;
-        const float step = (wp - w_[nb[i]]) - (pb.a * (un_[u] - un_[nu[i]]) + pb.b * (vn_[v] - vn_[nv[i]]));
-        if (std::fabs(step) > kl) continue;
-        best = bl;
-        best_res = res;
-      }
-      if (best == a) continue;
-      label_[p] = best;
-      grows[a].m.sub(un_[u], vn_[v], wp);
-      grows[best].m.add(un_[u], vn_[v], wp);
-      --grows[a].count;
-      ++grows[best].count;
-      ++stats_.border_pixels_moved;
-      for (int i = 0; i < k; ++i)
-        if (label_[nb[i]] == a) nxt.push_back(nb[i]);
-    }
-    std::swap(cur, nxt);
-  }
 }
 
 }  // namespace stairguide

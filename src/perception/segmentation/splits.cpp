@@ -402,14 +402,61 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
   // riser-like region that end under a hole can be such a sliver; the holes are found on the cell
   // grid (cells short of readings), so only their pixels are read.
   if (dirs_.size() < 2 || CW_ == 0 || cell_valid_.empty()) return;
+  if (!edge_band_candidates(grows)) return;
+  find_edge_tops(grows);
+  const std::vector<int>& tops = order_;
+  if (tops.empty()) return;
   const int K = kBorderBandRows;
-  const int cs = std::max(2, cfg_.cell_size_px);
+  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
+  std::vector<int>& slot = cid_;
+  const std::vector<int>& regs = live_;
+  const std::vector<float>& acc = edge_acc_;
+  // Candidates whose band, for some depth, holds enough pixels, lies behind the plane and is off
+  // it by half the gain a split needs (the rest of the gain can come from the rest's refit).
+  bool any = false;
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const float* a = &acc[i * 3 * K];
+    float cnt = 0.f, sr = 0.f, srr = 0.f;
+    bool pass = false;
+    for (int k = 0; k < K; ++k) {
+      cnt += a[3 * k], sr += a[3 * k + 1], srr += a[3 * k + 2];
+      pass |= cnt >= cfg_.region_min_pixels && sr < 0.f && srr >= 0.5 * kSplitGain * sig2;
+    }
+    if (a[0] < kSplitMinSide || !pass) slot[regs[i]] = -1;
+    any |= slot[regs[i]] >= 0;
+  }
+  if (!any) return;
+  bins_.assign(regs.size() * static_cast<std::size_t>(K), InvDepthMoments{});
+  for (int p : tops) {
+    const int l = label_[p];
+    if (slot[l] < 0) continue;
+    const int v = row_of(p), u = p - v * W_;
+    InvDepthMoments* b = &bins_[static_cast<std::size_t>(slot[l]) * K];
+    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) b[k].add(un_[u], vn_[v + k], w_[p + k * W_]);
+  }
+  for (std::size_t i = 0; i < regs.size(); ++i) {
+    const int r = regs[i];
+    if (slot[r] < 0) continue;
+    const BandSplit best = best_band_split(grows[r], &bins_[i * K], K, /*below_edge=*/true);
+    if (best.dir < 0) continue;
+    std::vector<int>& pix = split_pixels_;
+    pix.clear();
+    for (int p : tops) {
+      const int v = row_of(p);
+      for (int k = 0; k < best.rows && v + k < H_ && label_[p + k * W_] == r; ++k) pix.push_back(p + k * W_);
+    }
+    if (!move_to_new_region(grows, r, pix, best.dir)) continue;
+    refit_region(grows[r]);
+    ++stats_.edge_splits;
+  }
+}
+
+bool Segmentation::edge_band_candidates(const std::vector<Grow>& grows) {
   const int n = static_cast<int>(grows.size());
   const float cos_own = std::cos(cfg_.region_angle);
   // A tread and its riser meet at 90 degrees (give or take the build and the fits' noise).
   const float sin_cross = std::sin(15.f * 3.14159265f / 180.f);
   const float limit = 0.5f * tolerance_w();
-  const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
   // Candidate regions: planar, parallel to a dominant direction (a riser, the front of a nosing)
   // and square to another one (the treads).
   std::vector<int>& slot = cid_;
@@ -430,7 +477,14 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
     slot[r] = static_cast<int>(regs.size());
     regs.push_back(r);
   }
-  if (regs.empty()) return;
+  return !regs.empty();
+}
+
+void Segmentation::find_edge_tops(const std::vector<Grow>& grows) {
+  const int K = kBorderBandRows;
+  const int cs = std::max(2, cfg_.cell_size_px);
+  const std::vector<int>& slot = cid_;
+  const std::vector<int>& regs = live_;
   // Tops of columns under a hole, in the cells at an occlusion edge: cells short of readings by
   // two rows' worth, or below such a cell, with readings of their own. A top is a pixel of a
   // candidate whose two upper neighbours have no reading. Per candidate and row below the edge
@@ -495,45 +549,6 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
         }
       }
     }
-  if (tops.empty()) return;
-  // Candidates whose band, for some depth, holds enough pixels, lies behind the plane and is off
-  // it by half the gain a split needs (the rest of the gain can come from the rest's refit).
-  bool any = false;
-  for (std::size_t i = 0; i < regs.size(); ++i) {
-    const float* a = &acc[i * 3 * K];
-    float cnt = 0.f, sr = 0.f, srr = 0.f;
-    bool pass = false;
-    for (int k = 0; k < K; ++k) {
-      cnt += a[3 * k], sr += a[3 * k + 1], srr += a[3 * k + 2];
-      pass |= cnt >= cfg_.region_min_pixels && sr < 0.f && srr >= 0.5 * kSplitGain * sig2;
-    }
-    if (a[0] < kSplitMinSide || !pass) slot[regs[i]] = -1;
-    any |= slot[regs[i]] >= 0;
-  }
-  if (!any) return;
-  bins_.assign(regs.size() * static_cast<std::size_t>(K), InvDepthMoments{});
-  for (int p : tops) {
-    const int l = label_[p];
-    if (slot[l] < 0) continue;
-    const int v = row_of(p), u = p - v * W_;
-    InvDepthMoments* b = &bins_[static_cast<std::size_t>(slot[l]) * K];
-    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) b[k].add(un_[u], vn_[v + k], w_[p + k * W_]);
-  }
-  for (std::size_t i = 0; i < regs.size(); ++i) {
-    const int r = regs[i];
-    if (slot[r] < 0) continue;
-    const BandSplit best = best_band_split(grows[r], &bins_[i * K], K, /*below_edge=*/true);
-    if (best.dir < 0) continue;
-    std::vector<int>& pix = split_pixels_;
-    pix.clear();
-    for (int p : tops) {
-      const int v = row_of(p);
-      for (int k = 0; k < best.rows && v + k < H_ && label_[p + k * W_] == r; ++k) pix.push_back(p + k * W_);
-    }
-    if (!move_to_new_region(grows, r, pix, best.dir)) continue;
-    refit_region(grows[r]);
-    ++stats_.edge_splits;
-  }
 }
 
 }  // namespace stairguide
