@@ -206,6 +206,9 @@ class Segmentation {
   /// Seeds from runs of free pixels in one row on a dominant direction, grown across small gaps
   /// between rows (far treads of a descent seen as lines one pixel row tall).
   void line_pass(std::vector<Grow>& grows);
+  /// line_pass' seeds (line_seeds_): windows of runs of free pixels in one row, mostly with a hole
+  /// or a depth jump above and below, that lie on a dominant direction; nearest and best first.
+  void find_line_seeds();
   /// grow_region for line_pass: the neighbours of a pixel are its left and right ones and those
   /// up to kLineReach columns away in the rows above and below (g.dir fixed). The same return;
   /// also released when it continues without a depth jump into the rows above or below it.

@@ -290,6 +290,36 @@ void Segmentation::line_pass(std::vector<Grow>& grows) {
   // between rows. Only dominant directions: a line cannot fix a tilt.
   const int len = cfg_.strip_length_px;
   if (len < 2 || dirs_.empty()) return;
+  find_line_seeds();
+  const std::vector<LineSeed>& seeds = line_seeds_;
+  const int need = std::max(3, (3 * len) / 4);
+  auto free_px = [&](int p) { return label_[p] == -1 && z_[p] > 0.f && tried_[p] == 0; };
+  for (const LineSeed& sd : seeds) {
+    InvDepthMoments m;
+    seed_pixels_.clear();
+    const int row = sd.v * W_;
+    for (int k = sd.u0; k < sd.u0 + sd.n; ++k) {
+      if (!free_px(row + k)) continue;
+      seed_pixels_.push_back(row + k);
+      m.add(un_[k], vn_[sd.v], w_[row + k]);
+    }
+    if (static_cast<int>(seed_pixels_.size()) < need) continue;
+    Grow g;
+    g.dir = best_direction(m, g.plane);
+    if (g.dir < 0) continue;
+    ++stats_.seeds_used;
+    released_ = 0;
+    grow_line(static_cast<int>(grows.size()), seed_pixels_, g);
+    if (g.count == 0)
+      for (int i = 0; i < released_; ++i) tried_[static_cast<std::size_t>(queue_[i])] = 1;
+    else
+      ++stats_.line_regions;
+    grows.push_back(g);
+  }
+}
+
+void Segmentation::find_line_seeds() {
+  const int len = cfg_.strip_length_px;
   const int need = std::max(3, (3 * len) / 4);
   const int cs = std::max(2, cfg_.cell_size_px);
   const float limit = 0.5f * tolerance_w();
@@ -362,28 +392,6 @@ void Segmentation::line_pass(std::vector<Grow>& grows) {
     if (x.score != y.score) return x.score < y.score;
     return x.v != y.v ? x.v < y.v : x.u0 < y.u0;
   });
-  for (const LineSeed& sd : seeds) {
-    InvDepthMoments m;
-    seed_pixels_.clear();
-    const int row = sd.v * W_;
-    for (int k = sd.u0; k < sd.u0 + sd.n; ++k) {
-      if (!free_px(row + k)) continue;
-      seed_pixels_.push_back(row + k);
-      m.add(un_[k], vn_[sd.v], w_[row + k]);
-    }
-    if (static_cast<int>(seed_pixels_.size()) < need) continue;
-    Grow g;
-    g.dir = best_direction(m, g.plane);
-    if (g.dir < 0) continue;
-    ++stats_.seeds_used;
-    released_ = 0;
-    grow_line(static_cast<int>(grows.size()), seed_pixels_, g);
-    if (g.count == 0)
-      for (int i = 0; i < released_; ++i) tried_[static_cast<std::size_t>(queue_[i])] = 1;
-    else
-      ++stats_.line_regions;
-    grows.push_back(g);
-  }
 }
 
 }  // namespace stairguide
