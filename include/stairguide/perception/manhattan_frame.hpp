@@ -178,6 +178,38 @@ class ManhattanTracker {
   ManhattanEstimate confirm_by_lines(const std::vector<Vote>& votes, float total_area,
                                      const EdgeCompassResult& compass) const;
 
+  // estimate()'s phases (src/perception/manhattan/estimate.cpp).
+  /// Fills floor_pts_: samples of every horizontal plane at the floor's height.
+  void sample_floor(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
+  /// Fills struct_pts_ and region_samples_: samples of every other region.
+  void sample_structure(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
+  /// What vote_of needs of the floor's pose, computed once a frame.
+  struct VoteView {
+    Eigen::Matrix3f R;        // T_floor_camera's rotation
+    Eigen::Vector3f up_c;     // up in camera coordinates
+    float sin_tol = 0.f;      // sin(vertical_tolerance)
+    float camera_height = 0.f, full_w = 0.f, clip_depth = 0.f;
+  };
+  /// Fills votes_ (one per vertical plane, or level band); returns the regions' total area.
+  float collect_votes(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
+  /// The vote of region `k`; false when it casts none (not vertical, nor a level band).
+  bool vote_of(const PlaneRegion& r, int k, const VoteView& view, Vote& vote) const;
+  /// Sets each vote's side (has_side, nx, nz, limit, cx, cz) and `inside` (floor beyond it).
+  void mark_sides(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
+  /// m^2 of the other regions' samples [from, to) beyond a vote's plane.
+  float area_beyond(const Vote& v, std::size_t from, std::size_t to) const;
+  /// Sets Vote::structure_beyond.
+  void mark_structure_beyond();
+  /// Whether a wall that is not far (by range, or Vote::far) and wide enough agrees with `yaw`.
+  bool near_wall_agrees(float yaw, bool far_by_range) const;
+  /// The frame the planes make: the walls', the risers' or all planes'.
+  ManhattanEstimate frame_of_planes(float total_area, bool& bounding_only, bool& riser_frame);
+  /// Fills vetoes_: the walls seen beyond the planes that make `frame` that disagree with them.
+  void find_vetoes(const ManhattanEstimate& frame, bool riser_frame, bool bounding_only);
+  /// The frame the vetoing walls (or the image edges agreeing with them) give; false: none.
+  bool apply_vetoes(ManhattanEstimate& frame, float total_area, const std::function<EdgeCompassResult()>& compass,
+                    std::optional<EdgeCompassResult>& compass_cache) const;
+
   ManhattanConfig cfg_;
   float max_range_ = 0.f;
   float clear_depth_ = 0.f;  // m: 3 sigma of noise nearer than max_range_ (0: max_range_ unset)

@@ -160,6 +160,30 @@ class Segmentation {
   };
   void backproject(const RgbdFrame& frame);
   void cell_pass(std::vector<Grow>& grows);
+  /// Cell pass, its phases: the cell grid (cell of each column and row, the coordinate sums of a
+  /// full cell); each cell's moments and planarity test (planar cells into cells_); region growing
+  /// over the cell grid; the pixels of the region cells; and the pixels of each other cell beside
+  /// regions, handed to the neighbouring region whose plane fits them best.
+  void cell_grid(int cs);
+  void cell_moments(int cs);
+  /// cell_moments four cells of row `cv` at a time (SSE2); returns the first cell column left to do.
+  int cell_row_simd(int cv, int cs);
+  float cell_first_w(int cu, int cv, int cs) const;
+  void cell_finish(int cu, int cv, int cs, float w0, float n, float Sw, float Suw, float Svw, float Sww);
+  void grow_cells(std::vector<Grow>& grows);
+  void label_cell_pixels(int cs);
+  /// The regions around one cell that its pixels may join, with their planes' coefficients.
+  struct CellCands {
+    int cand[8];
+    float pa[8], pb[8], pc[8];
+    int lab_of[9];
+    int nk = 0;
+  };
+  void refine_cell(std::vector<Grow>& grows, int c, int cs);
+  /// Each pixel of row `v` of the cell at (u0, v0): its best candidate (cell_sel_) and label.
+  void select_cell_row(const CellCands& k, int v, int u0, int v0, int cs);
+  /// Each candidate's moments take its pixels of the cell, in raster order.
+  void add_cell_pixels(std::vector<Grow>& grows, const CellCands& k, int u0, int v0, int cs);
   void seed_pass(int cell, std::vector<Grow>& grows);
   /// Grows a region from `seed_pixels` (g.plane, g.dir set). Returns true when the region was
   /// grown with a fixed normal its pixels reject (it is then released, g.count == 0).
@@ -182,6 +206,9 @@ class Segmentation {
   /// Seeds from runs of free pixels in one row on a dominant direction, grown across small gaps
   /// between rows (far treads of a descent seen as lines one pixel row tall).
   void line_pass(std::vector<Grow>& grows);
+  /// line_pass' seeds (line_seeds_): windows of runs of free pixels in one row, mostly with a hole
+  /// or a depth jump above and below, that lie on a dominant direction; nearest and best first.
+  void find_line_seeds();
   /// grow_region for line_pass: the neighbours of a pixel are its left and right ones and those
   /// up to kLineReach columns away in the rows above and below (g.dir fixed). The same return;
   /// also released when it continues without a depth jump into the rows above or below it.
@@ -189,12 +216,24 @@ class Segmentation {
   /// Splits regions that straddle a crease between two dominant directions (a tread and its
   /// riser within one cell row, at range) along the crease line.
   void split_creases(std::vector<Grow>& grows);
+  /// split_creases' candidates (split_cands_): strips one cell row tall whose plane is a blend of
+  /// two dominant directions, with the (at most two) direction pairs and an image box holding them.
+  void find_crease_candidates(const std::vector<Grow>& grows);
+  /// Splits candidate `cd` along the crease line where that lowers the residual enough.
+  struct SplitCand;
+  void split_crease(std::vector<Grow>& grows, const SplitCand& cd);
   /// Splits off a band of rows at the top border of the view that lies on another dominant
   /// direction than the rest of its region (a tread sliver above its riser).
   void split_border_bands(std::vector<Grow>& grows);
   /// The same below an occlusion edge (no readings above): a tread's visible sliver between its
   /// riser and the shadow of the next nosing, taken by the riser's region.
   void split_edge_bands(std::vector<Grow>& grows);
+  /// split_edge_bands' candidate regions (live_, their slots in cid_): planar, parallel to one
+  /// dominant direction and square to another. False: none.
+  bool edge_band_candidates(const std::vector<Grow>& grows);
+  /// split_edge_bands' tops of columns under a hole (order_) and the residual sums per candidate
+  /// and row below them (edge_acc_).
+  void find_edge_tops(const std::vector<Grow>& grows);
   /// The band of a region's first rows (from the top border or below an occlusion edge) to split
   /// off onto a dominant direction: rows 0 and dir -1 when none explains the region better.
   /// `bins` holds the moments of the region's pixels per row (or per sweep step) from the border,
@@ -216,9 +255,29 @@ class Segmentation {
   /// Returns false (nothing changed) when the new region's fit fails.
   bool move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir);
   void merge_regions(std::vector<Grow>& grows);
+  /// merge_regions' phases: the live regions (live_, cid_), which of them touch (mask_) and the
+  /// seam samples (seams_), false when there is nothing to merge; the merges of touching pairs
+  /// (union-find in `parent`); the labels relabelled to their roots.
+  bool find_seams(const std::vector<Grow>& grows);
+  void merge_pairs(std::vector<Grow>& grows, std::vector<int>& parent);
+  void relabel_merged(const std::vector<int>& parent);
   void drop_curved_tiles(std::vector<Grow>& grows);
+  /// drop_curved_tiles' phases: the live regions, their areas and which are candidate facets
+  /// (returns how many); the seam contacts of each pair, and how many of them are smooth.
+  int curved_candidates(const std::vector<Grow>& grows);
+  void seam_contacts(const std::vector<Grow>& grows);
   void refine_borders(std::vector<Grow>& grows);
+  /// refine_borders' first layer: the pixels with a neighbour of another region (seed_pixels_).
+  void find_border_pixels();
   void finalize(std::vector<Grow>& grows, std::vector<PlaneRegion>& regions);
+  /// finalize's phases: which grown regions survive (their compact ids in order_, planes in
+  /// fits_; returns how many); the pooled pixel and point buffers handed out, biggest to the
+  /// biggest; one raster pass over the labels (pixels, points, sums); each region's description.
+  std::size_t keep_regions(std::vector<Grow>& grows);
+  void hand_out_buffers(const std::vector<Grow>& grows, std::vector<PlaneRegion>& regions, std::size_t out);
+  void raster_regions(std::vector<PlaneRegion>& regions, std::size_t out);
+  /// Centroid, area, principal rectangle, extent and curvature of region `id`.
+  void describe_region(PlaneRegion& R, std::size_t id, float area_k);
   void extract_clusters(std::vector<ObstacleCluster>& clusters);
   /// Inlier tolerance on the perpendicular distance (m) at depth z from a plane at distance d.
   /// v = p / width without a hardware division (exact for images up to 4096 wide).
@@ -271,6 +330,9 @@ class Segmentation {
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
   std::vector<std::uint16_t> cell_valid_;  // cell pass: pixels with a reading per cell
+  int cell_need_ = 0;                      // cell pass: pixels with a reading a planar cell needs
+  float cell_limit_ = 0.f;                 // cell pass: residual limit of a planar cell (1/m)
+  float cell_full_[5] = {0, 0, 0, 0, 0};   // cell pass: Su, Sv, Suu, Suv, Svv over a full cell
   std::vector<int> first_kept_;            // finalize: first point column at or after each column
   std::vector<std::uint8_t> stride_keep_;  // extract_clusters: columns, then rows, that keep points
   std::vector<int> cell_pix_;              // cell pass: one candidate's pixels in a cell, then k / cs
