@@ -40,6 +40,20 @@ const char* to_string(Cue c) {
   return "?";
 }
 
+bool marks_a_step(Cue c) {
+  switch (c) {
+    case Cue::kFirstStep:
+    case Cue::kTick:
+    case Cue::kCount:
+    case Cue::kStepsLeft:
+    case Cue::kLastStep:
+    case Cue::kEndOfStairs:
+      return true;
+    default:
+      return false;
+  }
+}
+
 int cue_priority(Cue c) {
   // Step feedback is the lowest (a newer step makes an old tick stale); what is ahead comes next;
   // the system's own blindness and the last step are warnings; a drop ahead is the highest.

@@ -24,8 +24,16 @@ struct FeedbackStage::Impl {
   // Cue latency: written by decide() and by the sound thread's on_start
   // (declared before the sinks: their threads are joined first).
   mutable std::mutex lat_mutex;
-  std::unordered_map<std::uint64_t, SteadyClock::time_point> pending;  // utterance id -> capture
+  struct Pending {
+    SteadyClock::time_point captured;
+    std::vector<fb::Cue> kinds;  // the cues the utterance says
+    bool step_timed = false;     // ... of which one marks a step (its step can pass)
+    bool superseded = false;     // a newer step's cue was given before this one started
+    SteadyClock::time_point next_step{};
+  };
+  std::unordered_map<std::uint64_t, Pending> pending;  // utterance id -> what it says, when
   LatencyHistogram latency;
+  std::vector<CueKindLatency> by_kind = std::vector<CueKindLatency>(fb::kCueKinds);
   std::uint64_t cues = 0;
   std::string last_cue;
 
@@ -60,13 +68,7 @@ struct FeedbackStage::Impl {
       fb::AudioEvents ev;
       ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
-      ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) {
-        std::lock_guard<std::mutex> lk(lat_mutex);
-        const auto it = pending.find(id);
-        if (it == pending.end()) return;
-        latency.add(std::chrono::duration<double, std::milli>(t - it->second).count());
-        pending.erase(it);
-      };
+      ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) { started(id, t); };
       audio = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
     } else {
       audio = std::make_unique<fb::NullAudioSink>();
@@ -90,6 +92,39 @@ struct FeedbackStage::Impl {
     }
   }
 
+  void started(std::uint64_t id, SteadyClock::time_point t) {
+    std::lock_guard<std::mutex> lk(lat_mutex);
+    const auto it = pending.find(id);
+    if (it == pending.end()) return;
+    const double ms = std::chrono::duration<double, std::milli>(t - it->second.captured).count();
+    latency.add(ms);
+    const bool late = it->second.superseded && t > it->second.next_step;
+    for (const fb::Cue c : it->second.kinds) {
+      auto& k = by_kind[static_cast<std::size_t>(c)];
+      ++k.sounded;
+      k.late += late;
+      k.samples_ms.push_back(ms);
+    }
+    pending.erase(it);
+  }
+
+  // Called with lat_mutex held: the cues of a frame are given at `captured`.
+  void note_given(std::uint64_t id, const std::vector<fb::Cue>& kinds, SteadyClock::time_point captured) {
+    bool timed = false;
+    for (const fb::Cue c : kinds) {
+      ++by_kind[static_cast<std::size_t>(c)].given;
+      timed = timed || fb::marks_a_step(c);
+    }
+    if (timed)
+      for (auto& [other, p] : pending)
+        if (p.step_timed && !p.superseded) {
+          p.superseded = true;
+          p.next_step = captured;
+        }
+    if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
+    pending[id] = Pending{captured, kinds, timed, false, {}};
+  }
+
   std::string deliver(const std::vector<fb::CueEvent>& cues_now, SteadyClock::time_point captured) {
     if (cues_now.empty()) return "";
     open_sinks();
@@ -102,8 +137,7 @@ struct FeedbackStage::Impl {
       u.label = fb::token(e);
       {
         std::lock_guard<std::mutex> lk(lat_mutex);
-        if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
-        pending[u.id] = captured;
+        note_given(u.id, {e.cue}, captured);
         ++cues;
         last_cue = u.label;
       }
@@ -201,6 +235,11 @@ FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
   c.p99_ms = impl_->latency.percentile(99);
   c.max_ms = impl_->latency.max();
   c.last = impl_->last_cue;
+  for (std::size_t i = 0; i < impl_->by_kind.size(); ++i)
+    if (impl_->by_kind[i].given > 0) {
+      c.by_kind.push_back(impl_->by_kind[i]);
+      c.by_kind.back().kind = fb::to_string(static_cast<fb::Cue>(i));
+    }
   return c;
 }
 
@@ -209,6 +248,7 @@ void FeedbackStage::clear_cue_latency() {
   impl_->latency.clear();
   impl_->pending.clear();
   impl_->cues = 0;
+  impl_->by_kind.assign(fb::kCueKinds, CueKindLatency{});
 }
 
 }  // namespace stairguide::runtime

@@ -26,6 +26,13 @@ enum class Cue {
   kEndOfStairs,  ///< off the flight, on the new floor
 };
 
+/// Number of Cue values (for tables indexed by cue).
+constexpr int kCueKinds = static_cast<int>(Cue::kEndOfStairs) + 1;
+
+/// Whether the cue marks a step of a flight (first step, tick, count, steps left, last step, end
+/// of stairs): its moment passes with the next step, after which it must not be heard.
+bool marks_a_step(Cue c);
+
 /// "ready", "camera_lost", "camera_back", "blind", "stairs_ahead", "drop_warning", "step_ahead",
 /// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs".
 const char* to_string(Cue c);
