@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -27,13 +28,15 @@ const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_feedback_files";
 
 const std::vector<std::string> kStairClips = {
     "stairs_up", "stairs_down",   "step_up",    "step_down", "curb_up", "curb_down", "first_step",
-    "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down"};
+    "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down",      "approach"};
 
 struct Result {
   int code = -1;
   std::vector<std::string> cues;  // frame-line cue tokens, in frame order
+  std::vector<std::pair<double, std::string>> told;  // each cue token (split at '+') with its frame's ts
   std::string summary;
-  std::vector<std::int16_t> audio;
+  std::vector<std::int16_t> audio;  // (left + right) / 2 of the stereo capture
+  sgtest::Stereo stereo;
   std::vector<std::pair<double, int>> edges;
   std::string log;
 };
@@ -66,12 +69,19 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
       std::istringstream is(line.substr(at + 5));
       std::string tok;
       is >> tok;
-      if (tok != "-") r.cues.push_back(tok);
+      if (tok != "-") {
+        r.cues.push_back(tok);
+        const auto ts = line.find(" ts=");
+        const double t = ts == std::string::npos ? -1.0 : std::atof(line.c_str() + ts + 4);
+        std::istringstream parts(tok);
+        for (std::string one; std::getline(parts, one, '+');) r.told.push_back({t, one});
+      }
     }
   }
   const int st = pclose(p);
   r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.audio = sgtest::read_raw(kDir / (name + ".raw"));
+  r.stereo = sgtest::split(sgtest::read_raw(kDir / (name + ".raw")));  // stereo: the default
+  r.audio = r.stereo.mid();
   std::ifstream ef(edges);
   double t;
   int v;
@@ -217,4 +227,39 @@ TEST(E2eFeedback, ClimbIsToldStepByStep) {
   for (const auto& n : names)
     if (n == "stairs_up" || n == "first_step" || n == "last_step" || n == "end_of_stairs") order.push_back(n);
   EXPECT_EQ(order, (std::vector<std::string>{"stairs_up", "first_step", "last_step", "end_of_stairs"}));
+}
+
+// The approach beep through the whole daemon on the descent walk: from the 2 m range in, beeps
+// whose interval (on the frames' clock) shrinks monotonically down to 0.5 m and stops with the
+// first step; every beep given is heard in the file PCM, in the stereo stream, none on the climb.
+TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
+  const Result r = run_daemon("e2e_approach", "synth:descend_3_steps", "--realtime");
+  ASSERT_EQ(r.code, 0) << r.log;
+  std::vector<double> t;
+  std::vector<double> d;
+  double first_step = -1.0;
+  for (const auto& [ts, tok] : r.told) {
+    if (tok.rfind("approach_down:", 0) == 0) {
+      t.push_back(ts);
+      d.push_back(std::atof(tok.c_str() + std::strlen("approach_down:")));
+    }
+    if (tok == "first_step" && first_step < 0) first_step = ts;
+  }
+  std::printf("descend_3_steps: %zu beeps at", t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) std::printf(" %.2fs/%.2fm", t[i], d[i]);
+  std::printf("; first step at %.2f s\n", first_step);
+  ASSERT_GE(t.size(), 5u) << ::testing::PrintToString(r.cues);
+  EXPECT_LE(d.front(), 2.0 + 1e-6);
+  // Monotonic from the range down to 0.5 m (on the frames' clock; a frame is 1/30 s).
+  for (std::size_t i = 2; i < t.size(); ++i) {
+    if (d[i - 1] < 0.5) break;  // the fastest beat, held
+    EXPECT_LE(t[i] - t[i - 1], t[i - 1] - t[i - 2] + 1.0 / 30 + 1e-6) << "beep " << i;
+  }
+  for (std::size_t i = 1; i < d.size(); ++i) EXPECT_LE(d[i], d[i - 1] + 1e-6);
+  if (first_step > 0)
+    for (double x : t) EXPECT_LE(x, first_step);
+  // Heard: as many beeps in the file PCM as were given (each 70 ms, mixed at once, never dropped).
+  const auto beeps = sgtest::find_all(r.audio, "approach", 0.9);
+  EXPECT_EQ(beeps.size(), t.size());
+  EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
 }

@@ -33,6 +33,8 @@ HapticPattern haptic_pattern(const CueEvent& e) {
       return {{150, 0}};
     case Cue::kStepsLeft:
       return {};  // a number: spoken only
+    case Cue::kApproach:
+      return {{40, 0}};  // one sharp pulse, repeated faster as the edge nears (the policy's rhythm)
   }
   return {};
 }

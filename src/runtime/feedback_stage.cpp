@@ -4,6 +4,8 @@
 // never waits on a device. A sink that cannot be had is logged and the other goes on.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <mutex>
 #include <unordered_map>
 
@@ -18,6 +20,13 @@ namespace stairguide::runtime {
 namespace fb = stairguide::feedback;
 using SteadyClock = std::chrono::steady_clock;
 
+namespace {
+// s a step's cue may wait for the sound device before it is stale (the device is closed or
+// failing, or a phrase that outranks it is speaking and it has no earcon to be told by): the next
+// step comes some 0.4 s later at a brisk pace, and a count heard after it is a wrong count.
+constexpr double kStepMaxWait = 0.15;
+}  // namespace
+
 struct FeedbackStage::Impl {
   PipelineConfig config;
   fb::CuePolicy policy;
@@ -25,7 +34,7 @@ struct FeedbackStage::Impl {
   // (declared before the sinks: their threads are joined first).
   mutable std::mutex lat_mutex;
   struct Pending {
-    SteadyClock::time_point captured;
+    SteadyClock::time_point captured, decided;
     std::vector<fb::Cue> kinds;  // the cues the utterance says
     bool step_timed = false;     // ... of which one marks a step (its step can pass)
     bool superseded = false;     // a newer step's cue was given before this one started
@@ -65,6 +74,7 @@ struct FeedbackStage::Impl {
       fb::AlsaSinkOptions o;
       o.device = f.audio_device;
       o.retry_s = f.audio_retry;
+      o.stereo = f.stereo_pan;
       fb::AudioEvents ev;
       ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
@@ -97,6 +107,7 @@ struct FeedbackStage::Impl {
     const auto it = pending.find(id);
     if (it == pending.end()) return;
     const double ms = std::chrono::duration<double, std::milli>(t - it->second.captured).count();
+    const double dms = std::chrono::duration<double, std::milli>(t - it->second.decided).count();
     latency.add(ms);
     const bool late = it->second.superseded && t > it->second.next_step;
     for (const fb::Cue c : it->second.kinds) {
@@ -104,6 +115,7 @@ struct FeedbackStage::Impl {
       ++k.sounded;
       k.late += late;
       k.samples_ms.push_back(ms);
+      k.from_decision_ms.push_back(dms);
     }
     pending.erase(it);
   }
@@ -122,33 +134,73 @@ struct FeedbackStage::Impl {
           p.next_step = captured;
         }
     if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
-    pending[id] = Pending{captured, kinds, timed, false, {}};
+    pending[id] = Pending{captured, SteadyClock::now(), kinds, timed, false, {}};
   }
 
+  // A frame's cues as the wearer hears them: its phrases said as one (the most urgent first), so
+  // that none of them waits behind another of the same moment; each earcon mixed on its own.
   std::string deliver(const std::vector<fb::CueEvent>& cues_now, SteadyClock::time_point captured) {
     if (cues_now.empty()) return "";
     open_sinks();
-    bool buzzed = false;
+    std::vector<fb::Utterance> out;
+    std::vector<std::vector<fb::Cue>> said;  // per utterance of `out`, the cues it says
+    fb::Utterance phrase;
+    std::vector<fb::Cue> phrase_kinds;
+    bool placed = false;
     for (const auto& e : cues_now) {
-      fb::Utterance u;
-      u.id = next_id++;
-      u.priority = e.priority;
-      u.clips = fb::clips_for(e);
-      u.label = fb::token(e);
-      {
-        std::lock_guard<std::mutex> lk(lat_mutex);
-        note_given(u.id, {e.cue}, captured);
-        ++cues;
-        last_cue = u.label;
+      const fb::CueSound how = fb::cue_sound(e.cue);
+      if (how == fb::CueSound::kEarcon) {
+        fb::Utterance u;
+        u.priority = e.priority;
+        u.clips = fb::clips_for(e);
+        u.label = fb::token(e);
+        u.delivery = fb::Delivery::kMix;
+        u.kinds = fb::cue_bit(e.cue);
+        u.pan = fb::cue_pan(e);
+        u.max_wait_s = kStepMaxWait;
+        out.push_back(std::move(u));
+        said.push_back({e.cue});
+        continue;
       }
-      audio->play(std::move(u));
-      // One pattern per frame, the most urgent (the cues come highest priority first).
-      if (!buzzed) {
-        const fb::HapticPattern p = fb::haptic_pattern(e);
-        if (!p.empty()) {
-          haptic->play(p, e.priority);
-          buzzed = true;
-        }
+      const auto c = fb::clips_for(e);
+      phrase.clips.insert(phrase.clips.end(), c.begin(), c.end());
+      phrase.label += (phrase.label.empty() ? "" : "+") + fb::token(e);
+      phrase.priority = std::max(phrase.priority, e.priority);
+      phrase.kinds |= fb::cue_bit(e.cue);
+      phrase.supersedes |= fb::cue_supersedes(e.cue);
+      if (how == fb::CueSound::kStepPhrase) {
+        phrase.delivery = fb::Delivery::kCut;
+        phrase.fallback = {"tick"};
+        phrase.max_wait_s = kStepMaxWait;
+      }
+      if (!placed && std::isfinite(e.bearing_rad)) {
+        phrase.pan = fb::cue_pan(e);
+        placed = true;
+      }
+      phrase_kinds.push_back(e.cue);
+    }
+    // A phrase does not make itself stale.
+    phrase.supersedes &= ~phrase.kinds;
+    if (!phrase_kinds.empty()) {
+      out.insert(out.begin(), std::move(phrase));
+      said.insert(said.begin(), phrase_kinds);
+    }
+    {
+      std::lock_guard<std::mutex> lk(lat_mutex);
+      cues += cues_now.size();
+      last_cue = fb::token(cues_now.back());
+      for (std::size_t i = 0; i < out.size(); ++i) {
+        out[i].id = next_id++;
+        note_given(out[i].id, said[i], captured);
+      }
+    }
+    for (auto& u : out) audio->play(std::move(u));
+    // One pattern per frame, the most urgent (the cues come highest priority first).
+    for (const auto& e : cues_now) {
+      const fb::HapticPattern p = fb::haptic_pattern(e);
+      if (!p.empty()) {
+        haptic->play(p, e.priority);
+        break;
       }
     }
     return fb::tokens(cues_now);
@@ -190,7 +242,7 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
   if (impl_->sinks_open &&
       (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
-       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
+       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled || a.stereo_pan != b.stereo_pan ||
        a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line))
     spdlog::info("feedback: sound device, sounds and buzzer settings apply at the next start");
   PipelineConfig keep = config;
@@ -202,6 +254,7 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
     keep.feedback.audio_device = old.audio_device;
     keep.feedback.sounds_dir = old.sounds_dir;
     keep.feedback.volume = old.volume;
+    keep.feedback.stereo_pan = old.stereo_pan;
     keep.feedback.haptic_enabled = old.haptic_enabled;
     keep.feedback.gpio_chip = old.gpio_chip;
     keep.feedback.gpio_line = old.gpio_line;

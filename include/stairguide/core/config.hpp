@@ -693,6 +693,13 @@ struct FeedbackConfig {
   int count_interval = 5;                 ///< steps between two spoken counts on a flight
   float min_tick_interval = 0.25f;        ///< s, shortest gap between two step ticks
   float audio_retry = 3.0f;               ///< s between two attempts to open the sound device
+  bool stereo_pan = true;                 ///< stereo output, each cue placed by the staircase's bearing
+  float approach_range = 2.0f;            ///< m, the approach beep starts this near a descent's first edge (0: off)
+  float approach_near = 0.5f;             ///< m, at and nearer than this the beep comes fastest
+  float approach_interval_far = 1.5f;     ///< s between two beeps at approach_range
+  float approach_interval_near = 0.25f;   ///< s between two beeps at approach_near (linear between)
+  float approach_cone = 0.61086524f;      ///< rad (35 deg), half-angle: the edge's bearing beyond it (turned away) stops the beep
+  float approach_stall = 2.0f;            ///< s without coming nearer (stopped) before the beep stops
 
   template <class V> void visit(V& v) {
     v.flag(audio_enabled, "audio_enabled", "play audio cues");
@@ -716,6 +723,14 @@ struct FeedbackConfig {
     v.num(count_interval, "count_interval_steps", Unit::kCount, 1, 100, "steps between two spoken counts on a flight");
     v.num(min_tick_interval, "min_tick_interval_s", Unit::kSecond, 0, 5, "shortest gap between two step ticks");
     v.num(audio_retry, "audio_retry_s", Unit::kSecond, 0.1, 600, "seconds between attempts to open the sound device");
+    v.flag(stereo_pan, "stereo_pan", "stereo output, each cue placed left or right by the staircase's bearing (false: mono)");
+    v.num(approach_range, "approach_range_m", Unit::kMetre, 0, 10,
+          "a descending staircase's first edge this near starts the repeating approach beep (0: off)");
+    v.num(approach_near, "approach_near_m", Unit::kMetre, 0.1, 5, "at and nearer than this the approach beep comes fastest");
+    v.num(approach_interval_far, "approach_interval_far_s", Unit::kSecond, 0.1, 10, "seconds between two approach beeps at approach_range_m");
+    v.num(approach_interval_near, "approach_interval_near_s", Unit::kSecond, 0.1, 10, "seconds between two approach beeps at approach_near_m (linear between)");
+    v.num(approach_cone, "approach_cone_deg", Unit::kDegree, 5, 90, "the edge further off straight ahead than this (turned away) stops the approach beep");
+    v.num(approach_stall, "approach_stall_s", Unit::kSecond, 0.2, 60, "this long without coming nearer (stopped) stops the approach beep");
   }
 };
 

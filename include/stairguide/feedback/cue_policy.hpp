@@ -15,6 +15,14 @@
 ///   (even within `repeat_time`).
 /// - Blind: no floor and nothing seen nor tracked for `blind_after` s: told once, then every
 ///   `blind_repeat` s while it lasts.
+/// - Approach: a confirmed descending staircase whose first edge is within `approach_range` m
+///   beeps (kApproach, an earcon and a pulse), again and again, the interval shrinking linearly
+///   from `approach_interval_far` s at the range to `approach_interval_near` s at `approach_near` m
+///   (parking-sensor style; the distance is the nearest of this approach after a 5-frame median,
+///   so a noisy reading never slows the beat while the wearer walks on). It stops on the first
+///   step, when the edge's bearing leaves the `approach_cone` (turned away), when the wearer has
+///   not come 0.15 m nearer for `approach_stall` s (stopped; it resumes on walking on), and when
+///   the staircase is forgotten. At every verbosity.
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
 ///   steps left, last step, end) follow its states; without it only the detection cues are given.
 ///
@@ -89,6 +97,8 @@ class CuePolicy {
   void detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out);
   void flight_cues(const TraversalResult& tr, double t, std::vector<CueEvent>& out);
   void blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out);
+  void approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out);
+  float approach_interval(float d) const;
 
   FeedbackConfig cfg_;
   Verbosity verbosity_ = Verbosity::kNormal;
@@ -101,6 +111,17 @@ class CuePolicy {
   int prev_climbed_ = 0;
   bool steps_left_told_ = false;
   double last_tick_t_ = -1e9;
+  // Approach beep (to a descending first edge).
+  struct Approach {
+    bool on = false;             // within range, ahead, walking: beeping
+    double last_beep_t = -1e9;
+    float nearest = 0.f;         // m, the nearest (filtered) distance of this approach
+    float ref_d = 0.f;           // m, distance when the wearer last came 0.15 m nearer ...
+    double ref_t = 0.0;          // ... and when
+    float recent[5] = {};        // the last distances, for the median
+    int n_recent = 0;
+  };
+  Approach approach_;
   // Blind.
   double blind_since_ = -1.0;
   double last_blind_t_ = -1e9;

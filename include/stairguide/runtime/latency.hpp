@@ -41,6 +41,9 @@ struct CueKindLatency {
   std::uint64_t sounded = 0;        ///< of them, started on the sound device
   std::uint64_t late = 0;           ///< started after the next step's frame (its step had passed)
   std::vector<double> samples_ms;   ///< every latency measured, in the order started
+  /// The feedback path's share of each: the decision on the frame -> its first sample handed
+  /// (the rest is capture -> decision, the stages' time).
+  std::vector<double> from_decision_ms;
 };
 
 }  // namespace stairguide::runtime
