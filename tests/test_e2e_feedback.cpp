@@ -229,37 +229,41 @@ TEST(E2eFeedback, ClimbIsToldStepByStep) {
   EXPECT_EQ(order, (std::vector<std::string>{"stairs_up", "first_step", "last_step", "end_of_stairs"}));
 }
 
-// The approach beep through the whole daemon on the descent walk: from the 2 m range in, beeps
-// whose interval (on the frames' clock) shrinks monotonically down to 0.5 m and stops with the
-// first step; every beep given is heard in the file PCM, in the stereo stream, none on the climb.
+// The approach beep through the whole daemon on the descent walks: from the 2 m range in (the
+// drop warning is the first beat), beeps whose interval (on the frames' clock) shrinks
+// monotonically down to 0.5 m and stops with the first step; every beep given is heard in the
+// file PCM (the stereo stream), and none on the stair-free sequences (StairFreeSequences...).
 TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
-  const Result r = run_daemon("e2e_approach", "synth:descend_3_steps", "--realtime");
-  ASSERT_EQ(r.code, 0) << r.log;
-  std::vector<double> t;
-  std::vector<double> d;
-  double first_step = -1.0;
-  for (const auto& [ts, tok] : r.told) {
-    if (tok.rfind("approach_down:", 0) == 0) {
-      t.push_back(ts);
-      d.push_back(std::atof(tok.c_str() + std::strlen("approach_down:")));
+  for (const char* walk : {"descend_3_steps", "descend_8_steps"}) {
+    const Result r = run_daemon(std::string("e2e_approach_") + walk, std::string("synth:") + walk, "--realtime");
+    ASSERT_EQ(r.code, 0) << r.log;
+    std::vector<double> t, d;
+    double first_step = -1.0;
+    int beeps_given = 0;
+    for (const auto& [ts, tok] : r.told) {
+      const bool warn = tok.rfind("drop_warning_down", 0) == 0, beep = tok.rfind("approach_down:", 0) == 0;
+      if ((warn && t.empty()) || beep) {
+        t.push_back(ts);
+        d.push_back(warn ? 2.0 : std::atof(tok.c_str() + std::strlen("approach_down:")));
+      }
+      beeps_given += beep;
+      if (tok == "first_step" && first_step < 0) first_step = ts;
     }
-    if (tok == "first_step" && first_step < 0) first_step = ts;
+    std::printf("%s: drop warning then beeps at", walk);
+    for (std::size_t i = 0; i < t.size(); ++i) std::printf(" %.2fs/%.2fm", t[i], d[i]);
+    std::printf("; first step at %.2f s\n", first_step);
+    ASSERT_GE(beeps_given, 4) << walk << ::testing::PrintToString(r.cues);
+    // Monotonic from the range down to 0.5 m (on the frames' clock; a frame is 1/30 s).
+    for (std::size_t i = 2; i < t.size(); ++i) {
+      if (d[i - 1] < 0.5) break;  // the fastest beat, held
+      EXPECT_LE(t[i] - t[i - 1], t[i - 1] - t[i - 2] + 1.0 / 30 + 1e-6) << walk << " beep " << i;
+    }
+    for (std::size_t i = 1; i < d.size(); ++i) EXPECT_LE(d[i], d[i - 1] + 1e-6) << walk;
+    if (first_step > 0) {
+      for (double x : t) EXPECT_LE(x, first_step) << walk;
+    }
+    // Heard: as many beeps in the file PCM as were given (70 ms each, mixed at once, never dropped).
+    EXPECT_EQ(sgtest::find_all(r.audio, "approach", 0.9).size(), static_cast<std::size_t>(beeps_given)) << walk;
+    EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
   }
-  std::printf("descend_3_steps: %zu beeps at", t.size());
-  for (std::size_t i = 0; i < t.size(); ++i) std::printf(" %.2fs/%.2fm", t[i], d[i]);
-  std::printf("; first step at %.2f s\n", first_step);
-  ASSERT_GE(t.size(), 5u) << ::testing::PrintToString(r.cues);
-  EXPECT_LE(d.front(), 2.0 + 1e-6);
-  // Monotonic from the range down to 0.5 m (on the frames' clock; a frame is 1/30 s).
-  for (std::size_t i = 2; i < t.size(); ++i) {
-    if (d[i - 1] < 0.5) break;  // the fastest beat, held
-    EXPECT_LE(t[i] - t[i - 1], t[i - 1] - t[i - 2] + 1.0 / 30 + 1e-6) << "beep " << i;
-  }
-  for (std::size_t i = 1; i < d.size(); ++i) EXPECT_LE(d[i], d[i - 1] + 1e-6);
-  if (first_step > 0)
-    for (double x : t) EXPECT_LE(x, first_step);
-  // Heard: as many beeps in the file PCM as were given (each 70 ms, mixed at once, never dropped).
-  const auto beeps = sgtest::find_all(r.audio, "approach", 0.9);
-  EXPECT_EQ(beeps.size(), t.size());
-  EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
 }

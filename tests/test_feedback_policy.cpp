@@ -510,11 +510,16 @@ TEST(FeedbackPolicy, ApproachBeepQuickensAsTheEdgeNears) {
     FeedbackConfig c;  // range 2 m, 1.5 s .. 0.25 s at 0.5 m
     CuePolicy p{c};
     const auto s = feed(p, walk_to_edge(0.0, 3.5f, 0.2f, 0.6f, noise));
-    const auto b = beeps(s);
-    ASSERT_GE(b.size(), 6u) << noise;
-    // The first beep when the edge came within 2 m (3.5 m at 0.6 m/s: at 2.5 s), give or take the
-    // confirmation (the staircase is held from 0.3 s) and the noise.
-    EXPECT_NEAR(b[0], 2.5, 0.15) << noise;
+    auto b = beeps(s);
+    ASSERT_GE(b.size(), 5u) << noise;
+    // The first beat when the edge came within 2 m (3.5 m at 0.6 m/s: at 2.5 s), give or take the
+    // noise: the drop warning, which stands for the first beep (no beep over its alarm).
+    double warned = -1;
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kDropWarning) warned = x.t;
+    EXPECT_NEAR(warned, 2.5, 0.15) << noise;
+    EXPECT_GT(b[0], warned);
+    b.insert(b.begin(), warned);
     std::vector<double> gaps;
     for (std::size_t i = 1; i < b.size(); ++i) gaps.push_back(b[i] - b[i - 1]);
     for (std::size_t i = 1; i < gaps.size(); ++i) EXPECT_LE(gaps[i], gaps[i - 1] + 1e-9) << noise << " beep " << i;
@@ -543,7 +548,7 @@ TEST(FeedbackPolicy, ApproachBeepStopsOnTheFirstStep) {
     if (x.e.cue == Cue::kFirstStep) first_step_t = x.t;
   ASSERT_GT(first_step_t, 0);
   const auto b = beeps(s);
-  ASSERT_GE(b.size(), 3u);
+  ASSERT_GE(b.size(), 2u);
   for (double t : b) EXPECT_LT(t, first_step_t);
   // Ascending flights never beep.
   CuePolicy q{FeedbackConfig{}};
@@ -581,7 +586,7 @@ TEST(FeedbackPolicy, ApproachBeepStopsWhenTurnedAwayOrStopped) {
         else
           after.push_back(f[i].t);
       }
-  EXPECT_GE(during_walk.size(), 2u);
+  EXPECT_GE(during_walk.size(), 1u);
   EXPECT_TRUE(during_turn.empty()) << ::testing::PrintToString(during_turn);
   ASSERT_FALSE(during_still.empty());
   EXPECT_LE(during_still.back(), still_from + c.approach_stall + kDt);

@@ -150,7 +150,11 @@ void CuePolicy::approach_cues(const Sighting& s, const TraversalResult& tr, doub
   }
   a.nearest = std::min(a.nearest, filtered);
   if (t - a.ref_t > cfg_.approach_stall) return;  // stopped: silent until walking on
+  // The drop warning is a beat of its own (a beep over its alarm would blur both): the next beep
+  // keeps the interval from it.
+  a.last_beep_t = std::max(a.last_beep_t, last_t_[static_cast<int>(Cue::kDropWarning)]);
   if (t - a.last_beep_t + 1e-6 < approach_interval(a.nearest)) return;
+  a.last_beep_t = t;
   CueEvent e;
   e.cue = Cue::kApproach;
   e.direction = -1;
@@ -158,7 +162,6 @@ void CuePolicy::approach_cues(const Sighting& s, const TraversalResult& tr, doub
   e.bearing_rad = s.bearing_rad;
   e.distance_m = a.nearest;
   emit(out, e, t);
-  a.last_beep_t = t;
 }
 
 void CuePolicy::detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out) {

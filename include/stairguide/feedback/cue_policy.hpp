@@ -22,7 +22,8 @@
 ///   so a noisy reading never slows the beat while the wearer walks on). It stops on the first
 ///   step, when the edge's bearing leaves the `approach_cone` (turned away), when the wearer has
 ///   not come 0.15 m nearer for `approach_stall` s (stopped; it resumes on walking on), and when
-///   the staircase is forgotten. At every verbosity.
+///   the staircase is forgotten. At every verbosity. The drop warning counts as a beat (no beep over
+///   its alarm; the next beep keeps the interval from it).
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
 ///   steps left, last step, end) follow its states; without it only the detection cues are given.
 ///
