@@ -93,7 +93,9 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
   return r;
 }
 
-bool stair_token(const std::string& t) { return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0; }
+bool stair_token(const std::string& t) {
+  return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0 && t.rfind("battery", 0) != 0 && t != "slow";
+}
 
 }  // namespace
 

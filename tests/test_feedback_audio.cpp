@@ -72,7 +72,7 @@ TEST(FeedbackSounds, EveryCueClipIsThereAndSmall) {
   }
   EXPECT_LT(bytes, 3u * 1024 * 1024);
   // Every cue the policy can give has all its clips.
-  for (int c = 0; c <= static_cast<int>(Cue::kEndOfStairs); ++c)
+  for (int c = 0; c < kCueKinds; ++c)
     for (int dir : {-1, 1}) {
       CueEvent e;
       e.cue = static_cast<Cue>(c);

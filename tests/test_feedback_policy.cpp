@@ -645,3 +645,71 @@ TEST(FeedbackPolicy, CueSoundsAndWhatTheyMakeStale) {
       EXPECT_EQ(cue_pan(x.e), 0.f) << token(x.e);
     }
 }
+
+// ------------------------------------------------------------------ the system's state
+
+TEST(FeedbackPolicy, BatteryLowThenCriticalOnceEachWithRepeats) {
+  FeedbackConfig c;  // low 15 %, critical 5 %, repeats 300 s / 60 s
+  CuePolicy p{c};
+  std::vector<std::string> said;
+  auto poll = [&](double t, float charge, bool charging = false) {
+    for (const auto& e : p.battery(t, true, charge, charging)) said.push_back(token(e));
+  };
+  for (int i = 0; i < 10; ++i) poll(i * 10.0, 0.40f - 0.02f * i);  // 40 % .. 22 %: nothing
+  EXPECT_TRUE(said.empty());
+  poll(100, 0.15f);  // at the mark: told
+  poll(110, 0.14f);  // once
+  poll(120, 0.17f);  // a reading back up within 3 points: as it was (not told again at 15)
+  poll(130, 0.15f);
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:15"}));
+  poll(420, 0.10f);  // 300 s later, still low: again
+  poll(430, 0.05f);  // critical: at once
+  poll(440, 0.04f);
+  poll(500, 0.03f);  // 70 s after: again
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:15", "battery_low:10", "battery_critical:5",
+                                            "battery_critical:3"}));
+  said.clear();
+  poll(510, 0.03f, true);  // charging: silent, and over
+  poll(520, 0.20f);
+  poll(530, 0.14f);  // a new fall: told again at once
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:14"}));
+  CuePolicy q{c};
+  EXPECT_TRUE(q.battery(0, false, 0.0f, false).empty());  // no battery (a desktop): nothing
+  for (Cue k : {Cue::kBatteryLow, Cue::kBatteryCritical}) {
+    CueEvent e;
+    e.cue = k;
+    EXPECT_FALSE(haptic_pattern(e).empty());
+    EXPECT_EQ(cue_sound(k), CueSound::kPhrase);
+  }
+  EXPECT_GT(cue_priority(Cue::kBatteryCritical), cue_priority(Cue::kStairsAhead));
+}
+
+TEST(FeedbackPolicy, SlowWhenPerceptionIsBehindLongEnough) {
+  FeedbackConfig c;  // behind: lag > 0.5 s for 3 s; again every 60 s
+  CuePolicy p{c};
+  std::vector<CueInput> f;
+  for (double t = 0; t < 10; t += kDt) {
+    CueInput in = floor_frame(t);
+    in.lag_s = t < 2 ? 0.05 : t < 3 ? 0.8 : t < 3.3 ? 0.1 : 0.9;  // a short spell, then a long one
+    f.push_back(in);
+  }
+  const auto s = feed(p, f);
+  std::vector<double> slow;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kSlow) slow.push_back(x.t);
+  ASSERT_EQ(slow.size(), 1u) << ::testing::PrintToString(toks(s));
+  EXPECT_NEAR(slow[0], 3.3 + c.slow_after, 2 * kDt + 1e-9);  // 3 s into the long spell, not the short one
+  // Quiet verbosity too; back on time and behind again: told again at once after slow_after.
+  FeedbackConfig q = c;
+  q.verbosity = "quiet";
+  CuePolicy r{q};
+  std::vector<CueInput> g;
+  for (double t = 0; t < 20; t += kDt) {
+    CueInput in = floor_frame(t);
+    in.lag_s = (t > 1 && t < 6) || t > 10 ? 1.0 : 0.02;
+    g.push_back(in);
+  }
+  int n = 0;
+  for (const auto& x : feed(r, g)) n += x.e.cue == Cue::kSlow;
+  EXPECT_EQ(n, 2);
+}

@@ -42,6 +42,12 @@ const char* to_string(Cue c) {
       return "end_of_stairs";
     case Cue::kApproach:
       return "approach";
+    case Cue::kBatteryLow:
+      return "battery_low";
+    case Cue::kBatteryCritical:
+      return "battery_critical";
+    case Cue::kSlow:
+      return "slow";
   }
   return "?";
 }
@@ -78,7 +84,12 @@ int cue_priority(Cue c) {
     case Cue::kCameraBack:
       return 4;
     case Cue::kApproach:
+    case Cue::kSlow:
       return 5;
+    case Cue::kBatteryLow:
+      return 3;
+    case Cue::kBatteryCritical:
+      return 7;
     case Cue::kLastStep:
     case Cue::kBlind:
       return 6;
@@ -210,6 +221,15 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kApproach:
       c = {"approach"};
       break;
+    case Cue::kBatteryLow:
+      c = {"battery_low"};
+      break;
+    case Cue::kBatteryCritical:
+      c = {"battery_critical"};
+      break;
+    case Cue::kSlow:
+      c = {"slow"};
+      break;
   }
   return c;
 }
@@ -220,7 +240,7 @@ const std::vector<std::string>& all_clip_names() {
         "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
         "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
-        "approach"};
+        "approach", "battery_low", "battery_critical", "slow"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

@@ -49,6 +49,9 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kBlind:
     case Cue::kDropWarning:
     case Cue::kApproach:
+    case Cue::kBatteryLow:
+    case Cue::kBatteryCritical:
+    case Cue::kSlow:
     case Cue::kLastStep:
     case Cue::kStairsAhead:  // as an earcon
     case Cue::kStepAhead:
@@ -67,6 +70,9 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kReady:
     case Cue::kCount:
     case Cue::kApproach:  // its own rhythm (approach_cues)
+    case Cue::kBatteryLow:  // their own repeats (battery(), step())
+    case Cue::kBatteryCritical:
+    case Cue::kSlow:
       return true;
     case Cue::kTick:
       return t - last >= cfg_.min_tick_interval;
@@ -290,6 +296,7 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     std::fill(std::begin(last_t_), std::end(last_t_), kNever);
     last_tick_t_ = last_blind_t_ = kNever;
     blind_since_ = -1.0;
+    slow_since_ = -1.0;
     approach_ = Approach{};
   }
   last_frame_t_ = t;
@@ -312,8 +319,40 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
   approach_cues(s, tr, t, out);
   if (tr.ran) flight_cues(tr, t, out);
   blind_cues(in, t, out);
+  // Perception behind the camera for long enough that what is told comes late.
+  if (in.lag_s > cfg_.slow_lag) {
+    if (slow_since_ < 0) slow_since_ = t;
+    if (t - slow_since_ >= cfg_.slow_after && t - last_t_[static_cast<int>(Cue::kSlow)] >= cfg_.slow_repeat) {
+      CueEvent e;
+      e.cue = Cue::kSlow;
+      emit(out, e, t);
+    }
+  } else if (in.lag_s < 0.5 * cfg_.slow_lag) {
+    slow_since_ = -1.0;
+    last_t_[static_cast<int>(Cue::kSlow)] = kNever;  // over: the next fall behind is told at once
+  }
   std::stable_sort(out.begin(), out.end(),
                    [](const CueEvent& a, const CueEvent& b) { return a.priority > b.priority; });
+  return out;
+}
+
+std::vector<CueEvent> CuePolicy::battery(double t, bool present, float charge, bool charging) {
+  std::vector<CueEvent> out;
+  if (!present || charging || charge > cfg_.battery_low + 0.03f) {
+    battery_told_ = 0;
+    return out;
+  }
+  const int level = charge <= cfg_.battery_critical ? 2 : charge <= cfg_.battery_low ? 1 : 0;
+  if (level == 0) return out;  // within the 3 points above the mark: as it was
+  const Cue c = level == 2 ? Cue::kBatteryCritical : Cue::kBatteryLow;
+  const double repeat = level == 2 ? cfg_.battery_critical_repeat : cfg_.battery_repeat;
+  if (level > battery_told_ || t - last_t_[static_cast<int>(c)] >= repeat) {
+    CueEvent e;
+    e.cue = c;
+    e.number = static_cast<int>(std::lround(charge * 100.f));
+    emit(out, e, t);
+    battery_told_ = std::max(battery_told_, level);
+  }
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include "stairguide/feedback/audio_sink.hpp"
 #include "stairguide/feedback/cue_policy.hpp"
 #include "stairguide/feedback/haptic.hpp"
+#include "stairguide/feedback/power_supply.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 
@@ -52,6 +53,8 @@ struct FeedbackStage::Impl {
   std::string last_state = "none";
   double last_t = 0.0;
   std::uint64_t next_id = 1;
+  SteadyClock::time_point next_battery_poll{};  // the first frame reads it
+  bool battery_seen = false;
 
   explicit Impl(const PipelineConfig& c) : config(c), policy(c.feedback) {}
 
@@ -223,7 +226,26 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   in.floor_found = perception.floor_found;
   in.stair = perception.stair;
   in.traversal = perception.traversal;
-  d.cue = impl_->deliver(impl_->policy.step(in), captured);
+  const auto now = SteadyClock::now();
+  in.lag_s = std::max(0.0, std::chrono::duration<double>(now - captured).count());
+  std::vector<fb::CueEvent> cues = impl_->policy.step(in);
+  // The battery, every battery_poll s (a few small sysfs reads, on the feedback thread).
+  const FeedbackConfig& f = impl_->config.feedback;
+  if (now >= impl_->next_battery_poll) {
+    impl_->next_battery_poll =
+        now + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(f.battery_poll));
+    const fb::BatteryStatus b = fb::read_battery(f.power_supply_dir);
+    if (b.present != impl_->battery_seen) {
+      impl_->battery_seen = b.present;
+      if (b.present)
+        spdlog::info("battery: {} in {} at {:.0f}%{}", b.name, f.power_supply_dir, b.charge * 100.f,
+                     b.charging ? ", charging" : "");
+    }
+    for (const auto& e : impl_->policy.battery(timestamp_s, b.present, b.charge, b.charging)) cues.push_back(e);
+    std::stable_sort(cues.begin(), cues.end(),
+                     [](const fb::CueEvent& a, const fb::CueEvent& b) { return a.priority > b.priority; });
+  }
+  d.cue = impl_->deliver(cues, captured);
   return d;
 }
 

@@ -28,17 +28,21 @@ enum class Cue {
   kEndOfStairs,  ///< off the flight, on the new floor
   kApproach,     ///< the approach beep: a descending first edge within approach range, repeated
                  ///< faster as it nears (`distance_m`)
+  kBatteryLow,       ///< the laptop's battery is low (`number`: percent), not charging
+  kBatteryCritical,  ///< ... critically low: the daemon will soon stop
+  kSlow,             ///< perception has fallen behind the camera for long enough to matter
 };
 
 /// Number of Cue values (for tables indexed by cue).
-constexpr int kCueKinds = static_cast<int>(Cue::kApproach) + 1;
+constexpr int kCueKinds = static_cast<int>(Cue::kSlow) + 1;
 
 /// Whether the cue marks a step of a flight (first step, tick, count, steps left, last step, end
 /// of stairs): its moment passes with the next step, after which it must not be heard.
 bool marks_a_step(Cue c);
 
 /// "ready", "camera_lost", "camera_back", "blind", "stairs_ahead", "drop_warning", "step_ahead",
-/// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs", "approach".
+/// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs", "approach",
+/// "battery_low", "battery_critical", "slow".
 const char* to_string(Cue c);
 
 /// Higher interrupts lower: a warning cuts a tick. Fixed per cue (see cue.cpp for the order).

@@ -27,6 +27,10 @@
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
 ///   steps left, last step, end) follow its states; without it only the detection cues are given.
 ///
+/// - System state, at every verbosity: battery low and critical (battery()), and "slow" once
+///   perception has been more than `slow_lag` s behind the camera (`lag_s`) for `slow_after` s,
+///   again every `slow_repeat` s while it lasts (over when the lag falls below half `slow_lag`).
+///
 /// Verbosity: quiet = warnings (drop, last step, blind, camera) and earcons for stairs and steps
 /// ahead; normal = the words for what is ahead, first step, ticks, counts every `count_interval`
 /// steps, steps left once known, end of stairs; verbose = also the distance as it shrinks and
@@ -50,6 +54,7 @@ struct CueInput {
   bool floor_found = false;   ///< the floor is seen in this frame
   StairSummary stair;         ///< this frame's detection
   TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
+  double lag_s = 0.0;         ///< s from the frame's capture to this decision (perception behind)
 };
 
 /// Clock position (1..12, 12 straight ahead, 3 to the right) of a bearing in rad; 12 for NaN.
@@ -66,6 +71,11 @@ class CuePolicy {
   /// The camera stopped sending / is back (`t`: time of the last frame seen, s).
   std::vector<CueEvent> camera_lost(double t);
   std::vector<CueEvent> camera_back(double t);
+  /// The battery as last read (power_supply.hpp), at frame time `t`: "battery low" when the charge
+  /// falls to `battery_low` (not charging), again every `battery_repeat` s while it lasts;
+  /// "battery critical" at `battery_critical`, every `battery_critical_repeat` s. Charging, or a
+  /// charge 3 points above the low mark, ends it (told again on the next fall).
+  std::vector<CueEvent> battery(double t, bool present, float charge, bool charging);
 
  private:
   struct Sighting {
@@ -127,7 +137,10 @@ class CuePolicy {
   double blind_since_ = -1.0;
   double last_blind_t_ = -1e9;
   double last_frame_t_ = -1e9;
-  double last_t_[16] = {};  // per Cue, the last time it was given
+  double last_t_[kCueKinds] = {};  // per Cue, the last time it was given
+  // System state.
+  int battery_told_ = 0;  // 0 nothing, 1 low, 2 critical: the level told of this fall
+  double slow_since_ = -1.0;
 };
 
 }  // namespace stairguide::feedback
