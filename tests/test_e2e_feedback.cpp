@@ -269,3 +269,38 @@ TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
     EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
   }
 }
+
+// The battery through the whole daemon, read from a fake sysfs power-supply folder: low (12 %,
+// discharging) is said and heard, critical (4 %) too, and on mains nothing.
+TEST(E2eFeedback, BatteryLowAndCriticalAreSaidFromTheSysfsFolder) {
+  struct Case {
+    const char* name;
+    const char* capacity;
+    const char* status;
+    const char* token;  // expected, "" none
+    const char* clip;
+  };
+  for (const Case& c : {Case{"e2e_batt_low", "12", "Discharging", "battery_low:12", "battery_low"},
+                        Case{"e2e_batt_crit", "4", "Discharging", "battery_critical:4", "battery_critical"},
+                        Case{"e2e_batt_mains", "4", "Charging", "", ""}}) {
+    const fs::path sys = kDir / (std::string(c.name) + "_sys") / "BAT0";
+    fs::create_directories(sys);
+    std::ofstream(sys / "type") << "Battery\n";
+    std::ofstream(sys / "capacity") << c.capacity << "\n";
+    std::ofstream(sys / "status") << c.status << "\n";
+    const Result r = run_daemon(c.name, "synth:corridor_static:30", "--realtime",
+                                "  power_supply_dir: \"" + sys.parent_path().string() + "\"\n");
+    ASSERT_EQ(r.code, 0) << r.log;
+    std::vector<std::string> battery;
+    for (const auto& [ts, tok] : r.told)
+      if (tok.rfind("battery", 0) == 0) battery.push_back(tok);
+    const auto heard = sgtest::names_of(sgtest::heard(r.audio, {"battery_low", "battery_critical"}));
+    if (*c.token) {
+      EXPECT_EQ(battery, (std::vector<std::string>{c.token})) << c.name;
+      EXPECT_EQ(heard, (std::vector<std::string>{c.clip})) << c.name;
+    } else {
+      EXPECT_TRUE(battery.empty()) << c.name << ::testing::PrintToString(battery);
+      EXPECT_TRUE(heard.empty()) << c.name;
+    }
+  }
+}

@@ -159,3 +159,26 @@ TEST(RuntimeFeedback, StairsAheadArePlacedByTheirBearing) {
   std::error_code ec;
   if (!::testing::Test::HasFailure()) fs::remove_all(kPanDir, ec);
 }
+
+// "slow" is decided from the frames' capture-to-decision lag: frames decided 0.8 s after their
+// capture for 4 s make the stage say it, once; frames on time never.
+TEST(RuntimeFeedback, SlowWhenTheFramesAreDecidedLate) {
+  for (const double lag : {0.8, 0.02}) {
+    FeedbackStage stage(no_sinks());
+    std::vector<std::string> cues;
+    for (int i = 0; i < 120; ++i) {
+      PerceptionOutput p;
+      p.seq = static_cast<std::uint64_t>(i);
+      p.ran = p.floor_found = true;
+      p.state = "floor";
+      const auto captured = std::chrono::steady_clock::now() -
+                            std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(lag));
+      const Decision d = stage.decide(p, nullptr, i / 30.0, captured);
+      if (!d.cue.empty()) cues.push_back(d.cue);
+    }
+    if (lag > 0.5)
+      EXPECT_EQ(cues, (std::vector<std::string>{"ready", "slow"}));
+    else
+      EXPECT_EQ(cues, (std::vector<std::string>{"ready"}));
+  }
+}
