@@ -21,14 +21,20 @@ namespace fs = std::filesystem;
 
 inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
 
-/// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 mono raw).
-inline void write_alsa_config(const fs::path& conf, const fs::path& dir,
-                              const std::vector<std::string>& names) {
+/// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 raw, interleaved
+/// as many channels as the sink opened it with). The names in `mono_only` are PCMs that refuse
+/// two channels (a `multi` PCM of one binding over the file PCM), as a mono sound card does.
+inline void write_alsa_config(const fs::path& conf, const fs::path& dir, const std::vector<std::string>& names,
+                              const std::vector<std::string>& mono_only = {}) {
   fs::create_directories(dir);
   std::ofstream f(conf);
   for (const auto& n : names)
     f << "pcm." << n << " {\n  type file\n  slave.pcm { type null }\n  file \""
       << (dir / (n + ".raw")).string() << "\"\n  format \"raw\"\n}\n";
+  for (const auto& n : mono_only)
+    f << "pcm." << n << "_file {\n  type file\n  slave.pcm { type null }\n  file \"" << (dir / (n + ".raw")).string()
+      << "\"\n  format \"raw\"\n}\npcm." << n << " {\n  type multi\n  slaves.a { pcm \"" << n
+      << "_file\" channels 1 }\n  bindings.0 { slave a channel 0 }\n}\n";
 }
 
 inline std::vector<std::int16_t> read_raw(const fs::path& p) {
@@ -39,6 +45,31 @@ inline std::vector<std::int16_t> read_raw(const fs::path& p) {
     s[i] = static_cast<std::int16_t>(static_cast<unsigned char>(b[2 * i]) |
                                      (static_cast<unsigned char>(b[2 * i + 1]) << 8));
   return s;
+}
+
+/// A stereo capture split into its channels.
+struct Stereo {
+  std::vector<std::int16_t> left, right;
+  /// (left + right) / 2: a centred cue is its clip scaled, a panned one too (for `heard`).
+  std::vector<std::int16_t> mid() const {
+    std::vector<std::int16_t> m(left.size());
+    for (std::size_t i = 0; i < m.size(); ++i) m[i] = static_cast<std::int16_t>((left[i] + right[i]) / 2);
+    return m;
+  }
+};
+inline Stereo split(const std::vector<std::int16_t>& interleaved) {
+  Stereo s;
+  for (std::size_t i = 0; i + 1 < interleaved.size(); i += 2) {
+    s.left.push_back(interleaved[i]);
+    s.right.push_back(interleaved[i + 1]);
+  }
+  return s;
+}
+/// Energy of samples [from, to) (whole capture by default).
+inline double energy(const std::vector<std::int16_t>& s, std::size_t from = 0, std::size_t to = ~std::size_t{0}) {
+  double e = 0.0;
+  for (std::size_t i = from; i < std::min(to, s.size()); ++i) e += static_cast<double>(s[i]) * s[i];
+  return e;
 }
 
 inline std::vector<std::int16_t> clip(const std::string& name) {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -27,13 +28,15 @@ const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_feedback_files";
 
 const std::vector<std::string> kStairClips = {
     "stairs_up", "stairs_down",   "step_up",    "step_down", "curb_up", "curb_down", "first_step",
-    "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down"};
+    "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down",      "approach"};
 
 struct Result {
   int code = -1;
   std::vector<std::string> cues;  // frame-line cue tokens, in frame order
+  std::vector<std::pair<double, std::string>> told;  // each cue token (split at '+') with its frame's ts
   std::string summary;
-  std::vector<std::int16_t> audio;
+  std::vector<std::int16_t> audio;  // (left + right) / 2 of the stereo capture
+  sgtest::Stereo stereo;
   std::vector<std::pair<double, int>> edges;
   std::string log;
 };
@@ -66,12 +69,19 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
       std::istringstream is(line.substr(at + 5));
       std::string tok;
       is >> tok;
-      if (tok != "-") r.cues.push_back(tok);
+      if (tok != "-") {
+        r.cues.push_back(tok);
+        const auto ts = line.find(" ts=");
+        const double t = ts == std::string::npos ? -1.0 : std::atof(line.c_str() + ts + 4);
+        std::istringstream parts(tok);
+        for (std::string one; std::getline(parts, one, '+');) r.told.push_back({t, one});
+      }
     }
   }
   const int st = pclose(p);
   r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.audio = sgtest::read_raw(kDir / (name + ".raw"));
+  r.stereo = sgtest::split(sgtest::read_raw(kDir / (name + ".raw")));  // stereo: the default
+  r.audio = r.stereo.mid();
   std::ifstream ef(edges);
   double t;
   int v;
@@ -83,7 +93,9 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
   return r;
 }
 
-bool stair_token(const std::string& t) { return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0; }
+bool stair_token(const std::string& t) {
+  return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0 && t.rfind("battery", 0) != 0 && t != "slow";
+}
 
 }  // namespace
 
@@ -225,4 +237,78 @@ TEST(E2eFeedback, ClimbIsToldStepByStep) {
   for (const auto& n : names)
     if (n == "stairs_up" || n == "first_step" || n == "last_step" || n == "end_of_stairs") order.push_back(n);
   EXPECT_EQ(order, (std::vector<std::string>{"stairs_up", "first_step", "last_step", "end_of_stairs"}));
+}
+
+// The approach beep through the whole daemon on the descent walks: from the 2 m range in (the
+// drop warning is the first beat), beeps whose interval (on the frames' clock) shrinks
+// monotonically down to 0.5 m and stops with the first step; every beep given is heard in the
+// file PCM (the stereo stream), and none on the stair-free sequences (StairFreeSequences...).
+TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
+  for (const char* walk : {"descend_3_steps", "descend_8_steps"}) {
+    const Result r = run_daemon(std::string("e2e_approach_") + walk, std::string("synth:") + walk, "--realtime");
+    ASSERT_EQ(r.code, 0) << r.log;
+    std::vector<double> t, d;
+    double first_step = -1.0;
+    int beeps_given = 0;
+    for (const auto& [ts, tok] : r.told) {
+      const bool warn = tok.rfind("drop_warning_down", 0) == 0, beep = tok.rfind("approach_down:", 0) == 0;
+      if ((warn && t.empty()) || beep) {
+        t.push_back(ts);
+        d.push_back(warn ? 2.0 : std::atof(tok.c_str() + std::strlen("approach_down:")));
+      }
+      beeps_given += beep;
+      if (tok == "first_step" && first_step < 0) first_step = ts;
+    }
+    std::printf("%s: drop warning then beeps at", walk);
+    for (std::size_t i = 0; i < t.size(); ++i) std::printf(" %.2fs/%.2fm", t[i], d[i]);
+    std::printf("; first step at %.2f s\n", first_step);
+    ASSERT_GE(beeps_given, 4) << walk << ::testing::PrintToString(r.cues);
+    // Monotonic from the range down to 0.5 m (on the frames' clock; a frame is 1/30 s).
+    for (std::size_t i = 2; i < t.size(); ++i) {
+      if (d[i - 1] < 0.5) break;  // the fastest beat, held
+      EXPECT_LE(t[i] - t[i - 1], t[i - 1] - t[i - 2] + 1.0 / 30 + 1e-6) << walk << " beep " << i;
+    }
+    for (std::size_t i = 1; i < d.size(); ++i) EXPECT_LE(d[i], d[i - 1] + 1e-6) << walk;
+    if (first_step > 0) {
+      for (double x : t) EXPECT_LE(x, first_step) << walk;
+    }
+    // Heard: as many beeps in the file PCM as were given (70 ms each, mixed at once, never dropped).
+    EXPECT_EQ(sgtest::find_all(r.audio, "approach", 0.9).size(), static_cast<std::size_t>(beeps_given)) << walk;
+    EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
+  }
+}
+
+// The battery through the whole daemon, read from a fake sysfs power-supply folder: low (12 %,
+// discharging) is said and heard, critical (4 %) too, and on mains nothing.
+TEST(E2eFeedback, BatteryLowAndCriticalAreSaidFromTheSysfsFolder) {
+  struct Case {
+    const char* name;
+    const char* capacity;
+    const char* status;
+    const char* token;  // expected, "" none
+    const char* clip;
+  };
+  for (const Case& c : {Case{"e2e_batt_low", "12", "Discharging", "battery_low:12", "battery_low"},
+                        Case{"e2e_batt_crit", "4", "Discharging", "battery_critical:4", "battery_critical"},
+                        Case{"e2e_batt_mains", "4", "Charging", "", ""}}) {
+    const fs::path sys = kDir / (std::string(c.name) + "_sys") / "BAT0";
+    fs::create_directories(sys);
+    std::ofstream(sys / "type") << "Battery\n";
+    std::ofstream(sys / "capacity") << c.capacity << "\n";
+    std::ofstream(sys / "status") << c.status << "\n";
+    const Result r = run_daemon(c.name, "synth:corridor_static:30", "--realtime",
+                                "  power_supply_dir: \"" + sys.parent_path().string() + "\"\n");
+    ASSERT_EQ(r.code, 0) << r.log;
+    std::vector<std::string> battery;
+    for (const auto& [ts, tok] : r.told)
+      if (tok.rfind("battery", 0) == 0) battery.push_back(tok);
+    const auto heard = sgtest::names_of(sgtest::heard(r.audio, {"battery_low", "battery_critical"}));
+    if (*c.token) {
+      EXPECT_EQ(battery, (std::vector<std::string>{c.token})) << c.name;
+      EXPECT_EQ(heard, (std::vector<std::string>{c.clip})) << c.name;
+    } else {
+      EXPECT_TRUE(battery.empty()) << c.name << ::testing::PrintToString(battery);
+      EXPECT_TRUE(heard.empty()) << c.name;
+    }
+  }
 }

@@ -47,9 +47,19 @@ std::vector<Said> feed(CuePolicy& p, const std::vector<CueInput>& frames) {
   return out;
 }
 
+/// The tokens of what was said, the approach beeps left out (their rhythm is tested on its own).
 std::vector<std::string> toks(const std::vector<Said>& s) {
   std::vector<std::string> t;
-  for (const auto& x : s) t.push_back(token(x.e));
+  for (const auto& x : s)
+    if (x.e.cue != Cue::kApproach) t.push_back(token(x.e));
+  return t;
+}
+
+/// The times of the approach beeps.
+std::vector<double> beeps(const std::vector<Said>& s) {
+  std::vector<double> t;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kApproach) t.push_back(x.t);
   return t;
 }
 
@@ -212,7 +222,10 @@ TEST(FeedbackPolicy, DropWarnedAgainOnlyAfterItWasForgotten) {
   for (auto& x : approach(7.0, StairKind::kDescending, 1.5f, 1.0)) g.push_back(x);
   s = feed(p, g);
   ASSERT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
-  EXPECT_NEAR(s.back().t, 7.0 + c.confirm_time, kDt + 1e-6);
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kDropWarning) {
+      EXPECT_NEAR(x.t, 7.0 + c.confirm_time, kDt + 1e-6);
+    }
   EXPECT_EQ(count_of(s, Cue::kStairsAhead), 0);
 }
 
@@ -469,4 +482,234 @@ TEST(FeedbackHapticPatterns, DirectionAndCountCoded) {
   EXPECT_GE(haptic_pattern(last)[0].on_ms, 5 * haptic_pattern(tick)[0].on_ms);
   EXPECT_EQ(haptic_pattern(drop).size(), 5u);
   EXPECT_EQ(haptic_pattern(blind).size(), 3u);
+}
+
+// ------------------------------------------------------------------ the approach beep
+
+namespace {
+/// Walking at `speed` m/s toward a descending first edge from `from` m down to `to` m (straight
+/// ahead unless `bearing`), one frame per kDt from t0; distances with +-`noise` m of alternating
+/// noise (a depth camera's distance is never smooth).
+std::vector<CueInput> walk_to_edge(double t0, float from, float to, float speed, float noise = 0.f,
+                                   float bearing = 0.f) {
+  std::vector<CueInput> f;
+  int i = 0;
+  for (double t = 0; from - speed * t > to; t += kDt, ++i) {
+    const float d = from - speed * static_cast<float>(t) + (i % 2 ? noise : -noise);
+    f.push_back(stair_frame(t0 + t, StairKind::kDescending, d, bearing));
+  }
+  return f;
+}
+}  // namespace
+
+// Parking-sensor style: from the range (2 m) in, one beep, then again and again, the interval
+// shrinking from 1.5 s at 2 m to 0.25 s at 0.5 m and never growing while the wearer walks on,
+// even on noisy distances; the first when the edge comes within range; none before.
+TEST(FeedbackPolicy, ApproachBeepQuickensAsTheEdgeNears) {
+  for (const float noise : {0.f, 0.04f}) {
+    FeedbackConfig c;  // range 2 m, 1.5 s .. 0.25 s at 0.5 m
+    CuePolicy p{c};
+    const auto s = feed(p, walk_to_edge(0.0, 3.5f, 0.2f, 0.6f, noise));
+    auto b = beeps(s);
+    ASSERT_GE(b.size(), 5u) << noise;
+    // The first beat when the edge came within 2 m (3.5 m at 0.6 m/s: at 2.5 s), give or take the
+    // noise: the drop warning, which stands for the first beep (no beep over its alarm).
+    double warned = -1;
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kDropWarning) warned = x.t;
+    EXPECT_NEAR(warned, 2.5, 0.15) << noise;
+    EXPECT_GT(b[0], warned);
+    b.insert(b.begin(), warned);
+    std::vector<double> gaps;
+    for (std::size_t i = 1; i < b.size(); ++i) gaps.push_back(b[i] - b[i - 1]);
+    for (std::size_t i = 1; i < gaps.size(); ++i) EXPECT_LE(gaps[i], gaps[i - 1] + 1e-9) << noise << " beep " << i;
+    EXPECT_GT(gaps.front(), 0.9) << noise;  // far: slow (1.5 s at 2 m, less as it nears)
+    EXPECT_NEAR(gaps.back(), 0.25, kDt + 1e-9) << noise;  // at and nearer than 0.5 m: 0.25 s
+    // The distance it beeps for goes down with the beeps.
+    float last = 1e9f;
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kApproach) {
+        EXPECT_LE(x.e.distance_m, last);
+        EXPECT_LE(x.e.distance_m, c.approach_range + noise);
+        last = x.e.distance_m;
+        EXPECT_EQ(haptic_pattern(x.e).size(), 1u);  // one pulse per beep
+        EXPECT_EQ(clips_for(x.e), (std::vector<std::string>{"approach"}));
+      }
+    // The interval between beeps follows the distance (linear between the two ends).
+    EXPECT_EQ(count_of(s, Cue::kDropWarning), 1);
+  }
+}
+
+TEST(FeedbackPolicy, ApproachBeepStopsOnTheFirstStep) {
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, scripted_flight(4, -1));
+  double first_step_t = -1;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kFirstStep) first_step_t = x.t;
+  ASSERT_GT(first_step_t, 0);
+  const auto b = beeps(s);
+  ASSERT_GE(b.size(), 2u);
+  for (double t : b) EXPECT_LT(t, first_step_t);
+  // Ascending flights never beep.
+  CuePolicy q{FeedbackConfig{}};
+  EXPECT_TRUE(beeps(feed(q, scripted_flight(4, 1))).empty());
+}
+
+TEST(FeedbackPolicy, ApproachBeepStopsWhenTurnedAwayOrStopped) {
+  FeedbackConfig c;  // cone 35 deg, stall 2 s
+  CuePolicy p{c};
+  // Walking in to 1.2 m: beeping.
+  auto f = walk_to_edge(0.0, 2.5f, 1.2f, 0.5f);
+  double t = f.back().t + kDt;
+  const std::size_t walked = f.size();
+  // Turned 60 deg away for 2 s (the edge still seen, at the side): silent.
+  for (double u = 0; u < 2.0; u += kDt) f.push_back(stair_frame(t + u, StairKind::kDescending, 1.2f, 1.05f));
+  t += 2.0;
+  const std::size_t turned = f.size();
+  // Back facing it and standing still for 4 s: beeps for the stall time, then silent.
+  for (double u = 0; u < 4.0; u += kDt) f.push_back(stair_frame(t + u, StairKind::kDescending, 1.2f, 0.f));
+  const double still_from = t;
+  t += 4.0;
+  // Walking on: beeping again.
+  for (auto& x : walk_to_edge(t, 1.2f, 0.5f, 0.5f)) f.push_back(x);
+  std::vector<Said> s;
+  std::vector<double> during_walk, during_turn, during_still, after;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (const auto& e : p.step(f[i]))
+      if (e.cue == Cue::kApproach) {
+        if (i < walked)
+          during_walk.push_back(f[i].t);
+        else if (i < turned)
+          during_turn.push_back(f[i].t);
+        else if (f[i].t < still_from + 4.0)
+          during_still.push_back(f[i].t);
+        else
+          after.push_back(f[i].t);
+      }
+  EXPECT_GE(during_walk.size(), 1u);
+  EXPECT_TRUE(during_turn.empty()) << ::testing::PrintToString(during_turn);
+  ASSERT_FALSE(during_still.empty());
+  EXPECT_LE(during_still.back(), still_from + c.approach_stall + kDt);
+  EXPECT_GE(after.size(), 2u);
+}
+
+TEST(FeedbackPolicy, ApproachBeepSilentWithoutADescent) {
+  CuePolicy p{FeedbackConfig{}};
+  std::vector<CueInput> f;
+  for (double t = 0; t < 10; t += kDt) f.push_back(floor_frame(t));
+  EXPECT_TRUE(beeps(feed(p, f)).empty());
+  CuePolicy q{FeedbackConfig{}};
+  EXPECT_TRUE(beeps(feed(q, approach(0.0, StairKind::kAscending, 3.f, 3.0))).empty());
+  CuePolicy r{FeedbackConfig{}};  // a flicker of a descent (never confirmed)
+  std::vector<CueInput> g;
+  for (int i = 0; i < 300; ++i)
+    g.push_back(i % 10 == 0 ? stair_frame(i * kDt, StairKind::kDescending, 1.0f) : floor_frame(i * kDt));
+  EXPECT_TRUE(beeps(feed(r, g)).empty());
+  FeedbackConfig off;
+  off.approach_range = 0.f;  // turned off
+  CuePolicy o{off};
+  EXPECT_TRUE(beeps(feed(o, walk_to_edge(0.0, 3.f, 0.3f, 0.6f))).empty());
+  // Quiet verbosity keeps it: a safety cue.
+  FeedbackConfig quiet;
+  quiet.verbosity = "quiet";
+  CuePolicy qq{quiet};
+  EXPECT_GE(beeps(feed(qq, walk_to_edge(0.0, 3.f, 0.3f, 0.6f))).size(), 5u);
+}
+
+// How each cue meets what sounds: earcons mix, the step's phrases cut and make the older step and
+// "ahead" phrases stale, the rest wait their turn; the staircase's side places the cue.
+TEST(FeedbackPolicy, CueSoundsAndWhatTheyMakeStale) {
+  EXPECT_EQ(cue_sound(Cue::kTick), CueSound::kEarcon);
+  EXPECT_EQ(cue_sound(Cue::kApproach), CueSound::kEarcon);
+  for (Cue c : {Cue::kFirstStep, Cue::kCount, Cue::kStepsLeft, Cue::kLastStep, Cue::kEndOfStairs}) {
+    EXPECT_EQ(cue_sound(c), CueSound::kStepPhrase) << to_string(c);
+    EXPECT_TRUE(cue_supersedes(c) & cue_bit(Cue::kStairsAhead)) << to_string(c);
+    EXPECT_TRUE(cue_supersedes(c) & cue_bit(Cue::kCount)) << to_string(c);
+    EXPECT_FALSE(cue_supersedes(c) & cue_bit(Cue::kCameraLost)) << to_string(c);
+  }
+  for (Cue c : {Cue::kReady, Cue::kStairsAhead, Cue::kDropWarning, Cue::kBlind, Cue::kCameraLost}) {
+    EXPECT_EQ(cue_sound(c), CueSound::kPhrase) << to_string(c);
+    EXPECT_EQ(cue_supersedes(c), 0u) << to_string(c);
+  }
+  // What is ahead is placed by its bearing (2 o'clock: to the right); the flight's cues centred.
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, approach(0.0, StairKind::kAscending, 3.f, 1.0, 1.0f));
+  ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1);
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kStairsAhead) {
+      EXPECT_GT(cue_pan(x.e), 0.4f);
+    }
+  CuePolicy q{FeedbackConfig{}};
+  for (const auto& x : feed(q, scripted_flight(4)))
+    if (x.e.cue != Cue::kStairsAhead) {
+      EXPECT_EQ(cue_pan(x.e), 0.f) << token(x.e);
+    }
+}
+
+// ------------------------------------------------------------------ the system's state
+
+TEST(FeedbackPolicy, BatteryLowThenCriticalOnceEachWithRepeats) {
+  FeedbackConfig c;  // low 15 %, critical 5 %, repeats 300 s / 60 s
+  CuePolicy p{c};
+  std::vector<std::string> said;
+  auto poll = [&](double t, float charge, bool charging = false) {
+    for (const auto& e : p.battery(t, true, charge, charging)) said.push_back(token(e));
+  };
+  for (int i = 0; i < 10; ++i) poll(i * 10.0, 0.40f - 0.02f * i);  // 40 % .. 22 %: nothing
+  EXPECT_TRUE(said.empty());
+  poll(100, 0.15f);  // at the mark: told
+  poll(110, 0.14f);  // once
+  poll(120, 0.17f);  // a reading back up within 3 points: as it was (not told again at 15)
+  poll(130, 0.15f);
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:15"}));
+  poll(420, 0.10f);  // 300 s later, still low: again
+  poll(430, 0.05f);  // critical: at once
+  poll(440, 0.04f);
+  poll(500, 0.03f);  // 70 s after: again
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:15", "battery_low:10", "battery_critical:5",
+                                            "battery_critical:3"}));
+  said.clear();
+  poll(510, 0.03f, true);  // charging: silent, and over
+  poll(520, 0.20f);
+  poll(530, 0.14f);  // a new fall: told again at once
+  EXPECT_EQ(said, (std::vector<std::string>{"battery_low:14"}));
+  CuePolicy q{c};
+  EXPECT_TRUE(q.battery(0, false, 0.0f, false).empty());  // no battery (a desktop): nothing
+  for (Cue k : {Cue::kBatteryLow, Cue::kBatteryCritical}) {
+    CueEvent e;
+    e.cue = k;
+    EXPECT_FALSE(haptic_pattern(e).empty());
+    EXPECT_EQ(cue_sound(k), CueSound::kPhrase);
+  }
+  EXPECT_GT(cue_priority(Cue::kBatteryCritical), cue_priority(Cue::kStairsAhead));
+}
+
+TEST(FeedbackPolicy, SlowWhenPerceptionIsBehindLongEnough) {
+  FeedbackConfig c;  // behind: lag > 0.5 s for 3 s; again every 60 s
+  CuePolicy p{c};
+  std::vector<CueInput> f;
+  for (double t = 0; t < 10; t += kDt) {
+    CueInput in = floor_frame(t);
+    in.lag_s = t < 2 ? 0.05 : t < 3 ? 0.8 : t < 3.3 ? 0.1 : 0.9;  // a short spell, then a long one
+    f.push_back(in);
+  }
+  const auto s = feed(p, f);
+  std::vector<double> slow;
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kSlow) slow.push_back(x.t);
+  ASSERT_EQ(slow.size(), 1u) << ::testing::PrintToString(toks(s));
+  EXPECT_NEAR(slow[0], 3.3 + c.slow_after, 2 * kDt + 1e-9);  // 3 s into the long spell, not the short one
+  // Quiet verbosity too; back on time and behind again: told again at once after slow_after.
+  FeedbackConfig q = c;
+  q.verbosity = "quiet";
+  CuePolicy r{q};
+  std::vector<CueInput> g;
+  for (double t = 0; t < 20; t += kDt) {
+    CueInput in = floor_frame(t);
+    in.lag_s = (t > 1 && t < 6) || t > 10 ? 1.0 : 0.02;
+    g.push_back(in);
+  }
+  int n = 0;
+  for (const auto& x : feed(r, g)) n += x.e.cue == Cue::kSlow;
+  EXPECT_EQ(n, 2);
 }

@@ -119,6 +119,15 @@ std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c) {
         "stair_modelling.riser_max_cm");
   order(c.stair_modelling.blondel_min, c.stair_modelling.blondel_max, "stair_modelling.blondel_min_cm",
         "stair_modelling.blondel_max_cm");
+  // The approach beep quickens as the edge nears: the near interval is the shorter, the near
+  // distance inside the range (a range of 0 turns the beep off and leaves them unused).
+  order(c.feedback.approach_interval_near, c.feedback.approach_interval_far, "feedback.approach_interval_near_s",
+        "feedback.approach_interval_far_s");
+  order(c.feedback.battery_critical, c.feedback.battery_low, "feedback.battery_critical_percent",
+        "feedback.battery_low_percent");
+  if (c.feedback.approach_range > 0.f && !(c.feedback.approach_near < c.feedback.approach_range))
+    out.push_back({"feedback.approach_near_m", "feedback.approach_range_m",
+                   "feedback.approach_near_m must be below feedback.approach_range_m (or the range 0: off)"});
   return out;
 }
 

@@ -1,5 +1,9 @@
 #include "stairguide/feedback/cue.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
 namespace stairguide::feedback {
 
 namespace {
@@ -36,8 +40,30 @@ const char* to_string(Cue c) {
       return "last_step";
     case Cue::kEndOfStairs:
       return "end_of_stairs";
+    case Cue::kApproach:
+      return "approach";
+    case Cue::kBatteryLow:
+      return "battery_low";
+    case Cue::kBatteryCritical:
+      return "battery_critical";
+    case Cue::kSlow:
+      return "slow";
   }
   return "?";
+}
+
+bool marks_a_step(Cue c) {
+  switch (c) {
+    case Cue::kFirstStep:
+    case Cue::kTick:
+    case Cue::kCount:
+    case Cue::kStepsLeft:
+    case Cue::kLastStep:
+    case Cue::kEndOfStairs:
+      return true;
+    default:
+      return false;
+  }
 }
 
 int cue_priority(Cue c) {
@@ -57,6 +83,13 @@ int cue_priority(Cue c) {
     case Cue::kEndOfStairs:
     case Cue::kCameraBack:
       return 4;
+    case Cue::kApproach:
+    case Cue::kSlow:
+      return 5;
+    case Cue::kBatteryLow:
+      return 3;
+    case Cue::kBatteryCritical:
+      return 7;
     case Cue::kLastStep:
     case Cue::kBlind:
       return 6;
@@ -68,8 +101,36 @@ int cue_priority(Cue c) {
   return 0;
 }
 
+CueSound cue_sound(Cue c) {
+  if (c == Cue::kTick || c == Cue::kApproach) return CueSound::kEarcon;
+  return marks_a_step(c) && c != Cue::kTick ? CueSound::kStepPhrase : CueSound::kPhrase;
+}
+
+std::uint32_t cue_supersedes(Cue c) {
+  if (cue_sound(c) != CueSound::kStepPhrase) return 0;
+  std::uint32_t s = cue_bit(Cue::kStairsAhead) | cue_bit(Cue::kStepAhead) | cue_bit(Cue::kDropWarning);
+  for (int k = 0; k < kCueKinds; ++k)
+    if (cue_sound(static_cast<Cue>(k)) == CueSound::kStepPhrase) s |= cue_bit(static_cast<Cue>(k));
+  return s;
+}
+
+float cue_pan(const CueEvent& e) {
+  if (!std::isfinite(e.bearing_rad)) return 0.f;
+  const float p = e.bearing_rad / static_cast<float>(M_PI / 2.0);
+  return std::clamp(p, -1.f, 1.f) * kMaxPan;
+}
+
 std::string token(const CueEvent& e) {
   std::string s = to_string(e.cue);
+  if (e.cue == Cue::kApproach) {
+    s += "_down";
+    if (std::isfinite(e.distance_m)) {
+      char b[32];
+      std::snprintf(b, sizeof b, ":%.2fm", static_cast<double>(e.distance_m));
+      s += b;
+    }
+    return s;
+  }
   if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning) {
     if (e.cue == Cue::kStepAhead) s = e.kind == StairKind::kCurb ? "curb" : "step";
     s += e.direction > 0 ? "_up" : "_down";
@@ -157,6 +218,18 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kEndOfStairs:
       c = {"end_of_stairs"};
       break;
+    case Cue::kApproach:
+      c = {"approach"};
+      break;
+    case Cue::kBatteryLow:
+      c = {"battery_low"};
+      break;
+    case Cue::kBatteryCritical:
+      c = {"battery_critical"};
+      break;
+    case Cue::kSlow:
+      c = {"slow"};
+      break;
   }
   return c;
 }
@@ -166,7 +239,8 @@ const std::vector<std::string>& all_clip_names() {
     std::vector<std::string> n = {
         "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
-        "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning"};
+        "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
+        "approach", "battery_low", "battery_critical", "slow"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

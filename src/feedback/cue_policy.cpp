@@ -48,6 +48,10 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kCameraBack:
     case Cue::kBlind:
     case Cue::kDropWarning:
+    case Cue::kApproach:
+    case Cue::kBatteryLow:
+    case Cue::kBatteryCritical:
+    case Cue::kSlow:
     case Cue::kLastStep:
     case Cue::kStairsAhead:  // as an earcon
     case Cue::kStepAhead:
@@ -65,6 +69,10 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kCameraBack:
     case Cue::kReady:
     case Cue::kCount:
+    case Cue::kApproach:  // its own rhythm (approach_cues)
+    case Cue::kBatteryLow:  // their own repeats (battery(), step())
+    case Cue::kBatteryCritical:
+    case Cue::kSlow:
       return true;
     case Cue::kTick:
       return t - last >= cfg_.min_tick_interval;
@@ -93,7 +101,73 @@ CueEvent CuePolicy::ahead_event(const Sighting& s, bool drop) const {
     e.clock = c == 12 && verbosity_ != Verbosity::kVerbose ? 0 : c;
   }
   e.earcon_only = verbosity_ == Verbosity::kQuiet && !drop;
+  e.bearing_rad = s.bearing_rad;
   return e;
+}
+
+float CuePolicy::approach_interval(float d) const {
+  const float far = cfg_.approach_interval_far, near = cfg_.approach_interval_near;
+  if (d >= cfg_.approach_range) return far;
+  if (d <= cfg_.approach_near) return near;
+  return near + (far - near) * (d - cfg_.approach_near) / (cfg_.approach_range - cfg_.approach_near);
+}
+
+void CuePolicy::approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out) {
+  constexpr float kNearer = 0.15f;      // m the wearer must come nearer to count as walking on
+  constexpr float kRangeMargin = 0.25f;  // m beyond the range before a beeping approach stops
+  Approach& a = approach_;
+  const bool stepped_on = tr.ran && (on_flight(tr.state) || tr.state == TraversalState::kArrived);
+  const bool descent_held = told_.active && told_.key == -1;
+  if (cfg_.approach_range <= 0.f || stepped_on || !descent_held) {
+    a = Approach{};
+    return;
+  }
+  // A frame without a sighting of it (a dropout) neither beeps nor ends the approach: it ends
+  // when the staircase is forgotten (above).
+  if (!s.present || key_of(s.kind, s.direction) != -1 || !std::isfinite(s.distance_m)) return;
+  const float d = s.distance_m;
+  const bool ahead = !std::isfinite(s.bearing_rad) || std::fabs(s.bearing_rad) <= cfg_.approach_cone;
+  if (!ahead) {
+    a = Approach{};  // turned away: facing it again starts a new approach
+    return;
+  }
+  // The median of the last 5 distances (a reading or two off by noise is not a step).
+  a.recent[a.n_recent % 5] = d;
+  ++a.n_recent;
+  float m[5];
+  const int n = std::min(a.n_recent, 5);
+  std::copy(a.recent, a.recent + n, m);
+  std::nth_element(m, m + n / 2, m + n);
+  const float filtered = m[n / 2];
+  // In range from approach_range in, out again beyond it by a margin (no on-off at the border).
+  if (filtered > cfg_.approach_range + (a.on ? kRangeMargin : 0.f)) {
+    a.on = false;
+    return;
+  }
+  if (!a.on) {
+    a.on = true;
+    a.nearest = filtered;
+    a.ref_d = d;
+    a.ref_t = t;
+  }
+  if (d < a.ref_d - kNearer) {
+    a.ref_d = d;
+    a.ref_t = t;
+  }
+  a.nearest = std::min(a.nearest, filtered);
+  if (t - a.ref_t > cfg_.approach_stall) return;  // stopped: silent until walking on
+  // The drop warning is a beat of its own (a beep over its alarm would blur both): the next beep
+  // keeps the interval from it.
+  a.last_beep_t = std::max(a.last_beep_t, last_t_[static_cast<int>(Cue::kDropWarning)]);
+  if (t - a.last_beep_t + 1e-6 < approach_interval(a.nearest)) return;
+  a.last_beep_t = t;
+  CueEvent e;
+  e.cue = Cue::kApproach;
+  e.direction = -1;
+  e.kind = StairKind::kDescending;
+  e.bearing_rad = s.bearing_rad;
+  e.distance_m = a.nearest;
+  emit(out, e, t);
 }
 
 void CuePolicy::detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out) {
@@ -222,6 +296,8 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     std::fill(std::begin(last_t_), std::end(last_t_), kNever);
     last_tick_t_ = last_blind_t_ = kNever;
     blind_since_ = -1.0;
+    slow_since_ = -1.0;
+    approach_ = Approach{};
   }
   last_frame_t_ = t;
   if (!ready_told_) {
@@ -240,10 +316,43 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
   }
   if (s.present && s.kind == StairKind::kNone) s.present = false;
   detection_cues(s, t, out);
+  approach_cues(s, tr, t, out);
   if (tr.ran) flight_cues(tr, t, out);
   blind_cues(in, t, out);
+  // Perception behind the camera for long enough that what is told comes late.
+  if (in.lag_s > cfg_.slow_lag) {
+    if (slow_since_ < 0) slow_since_ = t;
+    if (t - slow_since_ >= cfg_.slow_after && t - last_t_[static_cast<int>(Cue::kSlow)] >= cfg_.slow_repeat) {
+      CueEvent e;
+      e.cue = Cue::kSlow;
+      emit(out, e, t);
+    }
+  } else if (in.lag_s < 0.5 * cfg_.slow_lag) {
+    slow_since_ = -1.0;
+    last_t_[static_cast<int>(Cue::kSlow)] = kNever;  // over: the next fall behind is told at once
+  }
   std::stable_sort(out.begin(), out.end(),
                    [](const CueEvent& a, const CueEvent& b) { return a.priority > b.priority; });
+  return out;
+}
+
+std::vector<CueEvent> CuePolicy::battery(double t, bool present, float charge, bool charging) {
+  std::vector<CueEvent> out;
+  if (!present || charging || charge > cfg_.battery_low + 0.03f) {
+    battery_told_ = 0;
+    return out;
+  }
+  const int level = charge <= cfg_.battery_critical ? 2 : charge <= cfg_.battery_low ? 1 : 0;
+  if (level == 0) return out;  // within the 3 points above the mark: as it was
+  const Cue c = level == 2 ? Cue::kBatteryCritical : Cue::kBatteryLow;
+  const double repeat = level == 2 ? cfg_.battery_critical_repeat : cfg_.battery_repeat;
+  if (level > battery_told_ || t - last_t_[static_cast<int>(c)] >= repeat) {
+    CueEvent e;
+    e.cue = c;
+    e.number = static_cast<int>(std::lround(charge * 100.f));
+    emit(out, e, t);
+    battery_told_ = std::max(battery_told_, level);
+  }
   return out;
 }
 

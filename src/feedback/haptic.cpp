@@ -33,6 +33,14 @@ HapticPattern haptic_pattern(const CueEvent& e) {
       return {{150, 0}};
     case Cue::kStepsLeft:
       return {};  // a number: spoken only
+    case Cue::kApproach:
+      return {{40, 0}};  // one sharp pulse, repeated faster as the edge nears (the policy's rhythm)
+    case Cue::kBatteryLow:
+      return {{200, 150}, {200, 0}};
+    case Cue::kBatteryCritical:
+      return {{200, 100}, {200, 100}, {200, 100}, {200, 0}};
+    case Cue::kSlow:
+      return {};  // spoken only
   }
   return {};
 }

@@ -4,6 +4,8 @@
 // never waits on a device. A sink that cannot be had is logged and the other goes on.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <mutex>
 #include <unordered_map>
@@ -11,6 +13,7 @@
 #include "stairguide/feedback/audio_sink.hpp"
 #include "stairguide/feedback/cue_policy.hpp"
 #include "stairguide/feedback/haptic.hpp"
+#include "stairguide/feedback/power_supply.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 
@@ -19,29 +22,45 @@ namespace stairguide::runtime {
 namespace fb = stairguide::feedback;
 using SteadyClock = std::chrono::steady_clock;
 
+namespace {
+// s a step's cue may wait for the sound device before it is stale (the device is closed or
+// failing, or a phrase that outranks it is speaking and it has no earcon to be told by): the next
+// step comes some 0.4 s later at a brisk pace, and a count heard after it is a wrong count.
+constexpr double kStepMaxWait = 0.15;
+}  // namespace
+
 struct FeedbackStage::Impl {
   PipelineConfig config;
   fb::CuePolicy policy;
   // Cue latency: written by decide() and by the sound thread's on_start
   // (declared before the sinks: their threads are joined first).
   mutable std::mutex lat_mutex;
-  std::unordered_map<std::uint64_t, SteadyClock::time_point> pending;  // utterance id -> capture
+  struct Pending {
+    SteadyClock::time_point captured, decided;
+    std::vector<fb::Cue> kinds;  // the cues the utterance says
+    bool step_timed = false;     // ... of which one marks a step (its step can pass)
+    bool superseded = false;     // a newer step's cue was given before this one started
+    SteadyClock::time_point next_step{};
+  };
+  std::unordered_map<std::uint64_t, Pending> pending;  // utterance id -> what it says, when
   LatencyHistogram latency;
+  std::vector<CueKindLatency> by_kind = std::vector<CueKindLatency>(fb::kCueKinds);
   std::uint64_t cues = 0;
   std::string last_cue;
-  // Cues lost to a sound outage (issue 41: they left no trace). The ALSA sink drops an utterance
-  // that waited past its age limit or overflowed its queue (counted as stale); what still waits
-  // when the input has ended and drain() gave up is lost too.
-  std::uint64_t audio_given = 0, audio_started = 0, stale_seen = 0, unplayed_at_end = 0;
 
   std::unique_ptr<fb::AudioSink> audio;
   // `audio` when it is the ALSA sink (its counters); read by cue_latency() from any thread.
   std::atomic<fb::AlsaAudioSink*> alsa{nullptr};
+  // Cues lost to a sound outage (issue 41: they left no trace): dropped unplayed because they
+  // waited past their age or overflowed the queue, not made stale on purpose by a newer step.
+  std::uint64_t lost_seen = 0;
   std::unique_ptr<fb::Haptic> haptic;
   bool sinks_open = false;
   std::string last_state = "none";
   double last_t = 0.0;
   std::uint64_t next_id = 1;
+  SteadyClock::time_point next_battery_poll{};  // the first frame reads it
+  bool battery_seen = false;
 
   explicit Impl(const PipelineConfig& c) : config(c), policy(c.feedback) {}
 
@@ -64,17 +83,11 @@ struct FeedbackStage::Impl {
       fb::AlsaSinkOptions o;
       o.device = f.audio_device;
       o.retry_s = f.audio_retry;
+      o.stereo = f.stereo_pan;
       fb::AudioEvents ev;
       ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
-      ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) {
-        std::lock_guard<std::mutex> lk(lat_mutex);
-        ++audio_started;
-        const auto it = pending.find(id);
-        if (it == pending.end()) return;
-        latency.add(std::chrono::duration<double, std::milli>(t - it->second).count());
-        pending.erase(it);
-      };
+      ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) { started(id, t); };
       auto sink = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
       alsa = sink.get();
       audio = std::move(sink);
@@ -100,53 +113,126 @@ struct FeedbackStage::Impl {
     }
   }
 
-  std::string deliver(const std::vector<fb::CueEvent>& cues_now, SteadyClock::time_point captured) {
-    if (cues_now.empty()) return "";
-    open_sinks();
-    bool buzzed = false;
-    for (const auto& e : cues_now) {
-      fb::Utterance u;
-      u.id = next_id++;
-      u.priority = e.priority;
-      u.clips = fb::clips_for(e);
-      u.label = fb::token(e);
-      {
-        std::lock_guard<std::mutex> lk(lat_mutex);
-        if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
-        pending[u.id] = captured;
-        ++cues;
-        last_cue = u.label;
-        if (alsa) ++audio_given;
-      }
-      audio->play(std::move(u));
-      // One pattern per frame, the most urgent (the cues come highest priority first).
-      if (!buzzed) {
-        const fb::HapticPattern p = fb::haptic_pattern(e);
-        if (!p.empty()) {
-          haptic->play(p, e.priority);
-          buzzed = true;
-        }
-      }
-    }
-    check_lost();
-    return fb::tokens(cues_now);
+  /// Cues the sound device dropped unplayed so far (0 without the ALSA sink).
+  std::uint64_t lost() const {
+    const fb::AlsaAudioSink* sink = alsa.load();
+    if (!sink) return 0;
+    const auto c = sink->counters();
+    return c.stale > c.superseded ? c.stale - c.superseded : 0;
   }
 
   /// Logs the cues the sound device dropped since the last look.
   void check_lost() {
-    const fb::AlsaAudioSink* sink = alsa.load();
-    if (!sink) return;
-    const std::uint64_t stale = sink->counters().stale;
-    if (stale == stale_seen) return;
-    std::uint64_t lost = 0;
+    const std::uint64_t now = lost();
+    if (now == lost_seen) return;
+    const std::uint64_t n = now - lost_seen;
+    spdlog::warn("audio: {} cue{} dropped unplayed: the sound device '{}' could not take {} in time ({} lost so far)",
+                 n, n == 1 ? "" : "s", config.feedback.audio_device, n == 1 ? "it" : "them", now);
+    lost_seen = now;
+  }
+
+  void started(std::uint64_t id, SteadyClock::time_point t) {
+    std::lock_guard<std::mutex> lk(lat_mutex);
+    const auto it = pending.find(id);
+    if (it == pending.end()) return;
+    const double ms = std::chrono::duration<double, std::milli>(t - it->second.captured).count();
+    const double dms = std::chrono::duration<double, std::milli>(t - it->second.decided).count();
+    latency.add(ms);
+    const bool late = it->second.superseded && t > it->second.next_step;
+    for (const fb::Cue c : it->second.kinds) {
+      auto& k = by_kind[static_cast<std::size_t>(c)];
+      ++k.sounded;
+      k.late += late;
+      k.samples_ms.push_back(ms);
+      k.from_decision_ms.push_back(dms);
+    }
+    pending.erase(it);
+  }
+
+  // Called with lat_mutex held: the cues of a frame are given at `captured`.
+  void note_given(std::uint64_t id, const std::vector<fb::Cue>& kinds, SteadyClock::time_point captured) {
+    bool timed = false;
+    for (const fb::Cue c : kinds) {
+      ++by_kind[static_cast<std::size_t>(c)].given;
+      timed = timed || fb::marks_a_step(c);
+    }
+    if (timed)
+      for (auto& [other, p] : pending)
+        if (p.step_timed && !p.superseded) {
+          p.superseded = true;
+          p.next_step = captured;
+        }
+    if (pending.size() > 256) pending.clear();  // cues the device never started (closed)
+    pending[id] = Pending{captured, SteadyClock::now(), kinds, timed, false, {}};
+  }
+
+  // A frame's cues as the wearer hears them: its phrases said as one (the most urgent first), so
+  // that none of them waits behind another of the same moment; each earcon mixed on its own.
+  std::string deliver(const std::vector<fb::CueEvent>& cues_now, SteadyClock::time_point captured) {
+    if (cues_now.empty()) return "";
+    open_sinks();
+    std::vector<fb::Utterance> out;
+    std::vector<std::vector<fb::Cue>> said;  // per utterance of `out`, the cues it says
+    fb::Utterance phrase;
+    std::vector<fb::Cue> phrase_kinds;
+    bool placed = false;
+    for (const auto& e : cues_now) {
+      const fb::CueSound how = fb::cue_sound(e.cue);
+      if (how == fb::CueSound::kEarcon) {
+        fb::Utterance u;
+        u.priority = e.priority;
+        u.clips = fb::clips_for(e);
+        u.label = fb::token(e);
+        u.delivery = fb::Delivery::kMix;
+        u.kinds = fb::cue_bit(e.cue);
+        u.pan = fb::cue_pan(e);
+        u.max_wait_s = kStepMaxWait;
+        out.push_back(std::move(u));
+        said.push_back({e.cue});
+        continue;
+      }
+      const auto c = fb::clips_for(e);
+      phrase.clips.insert(phrase.clips.end(), c.begin(), c.end());
+      phrase.label += (phrase.label.empty() ? "" : "+") + fb::token(e);
+      phrase.priority = std::max(phrase.priority, e.priority);
+      phrase.kinds |= fb::cue_bit(e.cue);
+      phrase.supersedes |= fb::cue_supersedes(e.cue);
+      if (how == fb::CueSound::kStepPhrase) {
+        phrase.delivery = fb::Delivery::kCut;
+        phrase.fallback = {"tick"};
+        phrase.max_wait_s = kStepMaxWait;
+      }
+      if (!placed && std::isfinite(e.bearing_rad)) {
+        phrase.pan = fb::cue_pan(e);
+        placed = true;
+      }
+      phrase_kinds.push_back(e.cue);
+    }
+    // A phrase does not make itself stale.
+    phrase.supersedes &= ~phrase.kinds;
+    if (!phrase_kinds.empty()) {
+      out.insert(out.begin(), std::move(phrase));
+      said.insert(said.begin(), phrase_kinds);
+    }
     {
       std::lock_guard<std::mutex> lk(lat_mutex);
-      lost = stale + unplayed_at_end;
+      cues += cues_now.size();
+      last_cue = fb::token(cues_now.back());
+      for (std::size_t i = 0; i < out.size(); ++i) {
+        out[i].id = next_id++;
+        note_given(out[i].id, said[i], captured);
+      }
     }
-    spdlog::warn("audio: {} cue{} dropped unplayed: the sound device '{}' could not take {} in time ({} lost so far)",
-                 stale - stale_seen, stale - stale_seen == 1 ? "" : "s", config.feedback.audio_device,
-                 stale - stale_seen == 1 ? "it" : "them", lost);
-    stale_seen = stale;
+    for (auto& u : out) audio->play(std::move(u));
+    // One pattern per frame, the most urgent (the cues come highest priority first).
+    for (const auto& e : cues_now) {
+      const fb::HapticPattern p = fb::haptic_pattern(e);
+      if (!p.empty()) {
+        haptic->play(p, e.priority);
+        break;
+      }
+    }
+    return fb::tokens(cues_now);
   }
 };
 
@@ -167,7 +253,26 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   in.floor_found = perception.floor_found;
   in.stair = perception.stair;
   in.traversal = perception.traversal;
-  d.cue = impl_->deliver(impl_->policy.step(in), captured);
+  const auto now = SteadyClock::now();
+  in.lag_s = std::max(0.0, std::chrono::duration<double>(now - captured).count());
+  std::vector<fb::CueEvent> cues = impl_->policy.step(in);
+  // The battery, every battery_poll s (a few small sysfs reads, on the feedback thread).
+  const FeedbackConfig& f = impl_->config.feedback;
+  if (now >= impl_->next_battery_poll) {
+    impl_->next_battery_poll =
+        now + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(f.battery_poll));
+    const fb::BatteryStatus b = fb::read_battery(f.power_supply_dir);
+    if (b.present != impl_->battery_seen) {
+      impl_->battery_seen = b.present;
+      if (b.present)
+        spdlog::info("battery: {} in {} at {:.0f}%{}", b.name, f.power_supply_dir, b.charge * 100.f,
+                     b.charging ? ", charging" : "");
+    }
+    for (const auto& e : impl_->policy.battery(timestamp_s, b.present, b.charge, b.charging)) cues.push_back(e);
+    std::stable_sort(cues.begin(), cues.end(),
+                     [](const fb::CueEvent& a, const fb::CueEvent& b) { return a.priority > b.priority; });
+  }
+  d.cue = impl_->deliver(cues, captured);
   return d;
 }
 
@@ -186,7 +291,7 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
   if (impl_->sinks_open &&
       (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
-       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
+       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled || a.stereo_pan != b.stereo_pan ||
        a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line))
     spdlog::info("feedback: sound device, sounds and buzzer settings apply at the next start");
   PipelineConfig keep = config;
@@ -198,6 +303,7 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
     keep.feedback.audio_device = old.audio_device;
     keep.feedback.sounds_dir = old.sounds_dir;
     keep.feedback.volume = old.volume;
+    keep.feedback.stereo_pan = old.stereo_pan;
     keep.feedback.haptic_enabled = old.haptic_enabled;
     keep.feedback.gpio_chip = old.gpio_chip;
     keep.feedback.gpio_line = old.gpio_line;
@@ -217,40 +323,28 @@ std::string FeedbackStage::describe() const {
 void FeedbackStage::drain(std::chrono::milliseconds timeout) {
   if (!impl_->sinks_open) return;
   const auto until = SteadyClock::now() + timeout;
-  const bool idle = impl_->audio->drain(timeout);
+  impl_->audio->drain(timeout);
   impl_->check_lost();
-  if (const fb::AlsaAudioSink* alsa = impl_->alsa.load(); !idle && alsa) {
-    // The input has ended: what still waits for the device will not be heard.
-    const std::uint64_t stale = alsa->counters().stale;
-    std::uint64_t waiting = 0, lost = 0;
-    {
-      std::lock_guard<std::mutex> lk(impl_->lat_mutex);
-      const std::uint64_t done = impl_->audio_started + stale + impl_->unplayed_at_end;
-      waiting = impl_->audio_given > done ? impl_->audio_given - done : 0;
-      impl_->unplayed_at_end += waiting;
-      lost = stale + impl_->unplayed_at_end;
-    }
-    if (waiting > 0)
-      spdlog::warn("audio: {} cue{} still waiting for the sound device '{}' at the end of the input, never played "
-                   "({} lost in all)",
-                   waiting, waiting == 1 ? "" : "s", impl_->config.feedback.audio_device, lost);
-  }
   const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - SteadyClock::now());
   impl_->haptic->drain(std::max(left, std::chrono::milliseconds(0)));
 }
 
 FeedbackStage::CueLatency FeedbackStage::cue_latency() const {
-  const fb::AlsaAudioSink* alsa = impl_->alsa.load();
-  const std::uint64_t stale = alsa ? alsa->counters().stale : 0;  // before lat_mutex: never both held
+  const std::uint64_t lost = impl_->lost();  // before lat_mutex: never both held
   std::lock_guard<std::mutex> lk(impl_->lat_mutex);
   CueLatency c;
+  c.lost = lost;
   c.cues = impl_->cues;
   c.sounded = impl_->latency.count();
   c.p50_ms = impl_->latency.percentile(50);
   c.p99_ms = impl_->latency.percentile(99);
   c.max_ms = impl_->latency.max();
   c.last = impl_->last_cue;
-  c.lost = impl_->unplayed_at_end + stale;
+  for (std::size_t i = 0; i < impl_->by_kind.size(); ++i)
+    if (impl_->by_kind[i].given > 0) {
+      c.by_kind.push_back(impl_->by_kind[i]);
+      c.by_kind.back().kind = fb::to_string(static_cast<fb::Cue>(i));
+    }
   return c;
 }
 
@@ -259,6 +353,7 @@ void FeedbackStage::clear_cue_latency() {
   impl_->latency.clear();
   impl_->pending.clear();
   impl_->cues = 0;
+  impl_->by_kind.assign(fb::kCueKinds, CueKindLatency{});
 }
 
 }  // namespace stairguide::runtime

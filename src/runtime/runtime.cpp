@@ -964,6 +964,7 @@ struct Runtime::Impl {
     s.cue_latency_p99_ms = cl.p99_ms;
     s.last_cue = cl.last;
     s.cues_lost = cl.lost;
+    s.cue_kinds = cl.by_kind;
     if (have_first && have_last) s.elapsed_s = std::max(0.0, seconds_between(first_capture, last_decision));
     if (last_traversal.ran) {
       s.traversal_state = to_string(last_traversal.state);

@@ -696,6 +696,22 @@ struct FeedbackConfig {
   int count_interval = 5;                 ///< steps between two spoken counts on a flight
   float min_tick_interval = 0.25f;        ///< s, shortest gap between two step ticks
   float audio_retry = 3.0f;               ///< s between two attempts to open the sound device
+  bool stereo_pan = true;                 ///< stereo output, each cue placed by the staircase's bearing
+  float approach_range = 2.0f;            ///< m, the approach beep starts this near a descent's first edge (0: off)
+  float approach_near = 0.5f;             ///< m, at and nearer than this the beep comes fastest
+  float approach_interval_far = 1.5f;     ///< s between two beeps at approach_range
+  float approach_interval_near = 0.25f;   ///< s between two beeps at approach_near (linear between)
+  float approach_cone = 0.61086524f;      ///< rad (35 deg), half-angle: the edge's bearing beyond it (turned away) stops the beep
+  float approach_stall = 2.0f;            ///< s without coming nearer (stopped) before the beep stops
+  std::string power_supply_dir = "/sys/class/power_supply";  ///< sysfs power-supply class (a fake folder in tests)
+  float battery_poll = 10.0f;             ///< s between two readings of the battery
+  float battery_low = 0.15f;              ///< fraction of full charge, at or below (not charging): "battery low"
+  float battery_critical = 0.05f;         ///< fraction of full charge, at or below (not charging): "battery critical"
+  float battery_repeat = 300.0f;          ///< s between two "battery low" while it lasts
+  float battery_critical_repeat = 60.0f;  ///< s between two "battery critical" while it lasts
+  float slow_lag = 0.5f;                  ///< s from capture to decision beyond which perception is behind
+  float slow_after = 3.0f;                ///< s behind before "slow" is said
+  float slow_repeat = 60.0f;              ///< s between two "slow" while it lasts
 
   template <class V> void visit(V& v) {
     v.flag(audio_enabled, "audio_enabled", "play audio cues");
@@ -719,6 +735,23 @@ struct FeedbackConfig {
     v.num(count_interval, "count_interval_steps", Unit::kCount, 1, 100, "steps between two spoken counts on a flight");
     v.num(min_tick_interval, "min_tick_interval_s", Unit::kSecond, 0, 5, "shortest gap between two step ticks");
     v.num(audio_retry, "audio_retry_s", Unit::kSecond, 0.1, 600, "seconds between attempts to open the sound device");
+    v.flag(stereo_pan, "stereo_pan", "stereo output, each cue placed left or right by the staircase's bearing (false: mono)");
+    v.num(approach_range, "approach_range_m", Unit::kMetre, 0, 10,
+          "a descending staircase's first edge this near starts the repeating approach beep (0: off)");
+    v.num(approach_near, "approach_near_m", Unit::kMetre, 0.1, 5, "at and nearer than this the approach beep comes fastest");
+    v.num(approach_interval_far, "approach_interval_far_s", Unit::kSecond, 0.1, 10, "seconds between two approach beeps at approach_range_m");
+    v.num(approach_interval_near, "approach_interval_near_s", Unit::kSecond, 0.1, 10, "seconds between two approach beeps at approach_near_m (linear between)");
+    v.num(approach_cone, "approach_cone_deg", Unit::kDegree, 5, 90, "the edge further off straight ahead than this (turned away) stops the approach beep");
+    v.num(approach_stall, "approach_stall_s", Unit::kSecond, 0.2, 60, "this long without coming nearer (stopped) stops the approach beep");
+    v.text(power_supply_dir, "power_supply_dir", {}, "sysfs power-supply class read for the battery (its Battery-type entries)");
+    v.num(battery_poll, "battery_poll_s", Unit::kSecond, 0.1, 600, "seconds between two readings of the battery");
+    v.num(battery_low, "battery_low_percent", Unit::kPercent, 1, 100, "at or below this charge, not charging: say battery low");
+    v.num(battery_critical, "battery_critical_percent", Unit::kPercent, 0, 100, "at or below this charge, not charging: say battery critical");
+    v.num(battery_repeat, "battery_repeat_s", Unit::kSecond, 10, 36000, "say battery low again at this interval while it lasts");
+    v.num(battery_critical_repeat, "battery_critical_repeat_s", Unit::kSecond, 5, 3600, "say battery critical again at this interval while it lasts");
+    v.num(slow_lag, "slow_lag_s", Unit::kSecond, 0.05, 10, "capture to decision longer than this: perception is behind the camera");
+    v.num(slow_after, "slow_after_s", Unit::kSecond, 0.1, 600, "behind this long: say slow");
+    v.num(slow_repeat, "slow_repeat_s", Unit::kSecond, 1, 3600, "say slow again at this interval while it lasts");
   }
 };
 

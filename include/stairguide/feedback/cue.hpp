@@ -3,6 +3,8 @@
 /// What the user is told: one `CueEvent` per thing said (and felt), with its priority, and how
 /// each is spoken (the WAV clips, in order) and buzzed (the haptic pattern, haptic.hpp).
 
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,10 +26,23 @@ enum class Cue {
   kStepsLeft,    ///< steps still to go (`number`)
   kLastStep,     ///< the next step (or the one underfoot) is the last
   kEndOfStairs,  ///< off the flight, on the new floor
+  kApproach,     ///< the approach beep: a descending first edge within approach range, repeated
+                 ///< faster as it nears (`distance_m`)
+  kBatteryLow,       ///< the laptop's battery is low (`number`: percent), not charging
+  kBatteryCritical,  ///< ... critically low: the daemon will soon stop
+  kSlow,             ///< perception has fallen behind the camera for long enough to matter
 };
 
+/// Number of Cue values (for tables indexed by cue).
+constexpr int kCueKinds = static_cast<int>(Cue::kSlow) + 1;
+
+/// Whether the cue marks a step of a flight (first step, tick, count, steps left, last step, end
+/// of stairs): its moment passes with the next step, after which it must not be heard.
+bool marks_a_step(Cue c);
+
 /// "ready", "camera_lost", "camera_back", "blind", "stairs_ahead", "drop_warning", "step_ahead",
-/// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs".
+/// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs", "approach",
+/// "battery_low", "battery_critical", "slow".
 const char* to_string(Cue c);
 
 /// Higher interrupts lower: a warning cuts a tick. Fixed per cue (see cue.cpp for the order).
@@ -41,7 +56,31 @@ struct CueEvent {
   int number = -1;                    ///< metres, count or steps left; -1 when not said
   int clock = 0;                      ///< clock position 1..12 of the stairs, 0 when not said
   bool earcon_only = false;           ///< quiet verbosity: the earcon instead of the words
+  /// rad, bearing of the staircase the cue is about (positive to the right); NaN: not placed
+  /// (system cues, and the flight's cues: the staircase is under the feet).
+  float bearing_rad = std::numeric_limits<float>::quiet_NaN();
+  /// m, the distance to the first edge (kApproach); NaN otherwise.
+  float distance_m = std::numeric_limits<float>::quiet_NaN();
 };
+
+/// How a cue is heard against what already sounds (audio_sink.hpp's deliveries):
+/// - kEarcon (tick, approach beep): mixed over whatever sounds, at once;
+/// - kStepPhrase (first step, count, steps left, last step, end of stairs): said at once, cutting
+///   the phrase speaking, and making stale the older step and "ahead" phrases (its step has come);
+///   when a phrase that outranks it is speaking (camera lost, cannot see) a tick marks the step;
+/// - kPhrase (the rest): waits its turn by priority; a higher one cuts a lower one.
+enum class CueSound { kPhrase, kStepPhrase, kEarcon };
+CueSound cue_sound(Cue c);
+/// The cue as a bit (for the sink's `kinds` and `supersedes` sets).
+inline std::uint32_t cue_bit(Cue c) { return 1u << static_cast<unsigned>(c); }
+/// The cues a cue makes stale when it is given (a bit set): for a step phrase, every older step
+/// phrase and what was said of the staircase ahead; none for the others.
+std::uint32_t cue_supersedes(Cue c);
+/// Where the cue is placed between the ears: -1 left .. +1 right, from its bearing (0 for NaN).
+/// Linear in the bearing up to kMaxPan at +-90 deg (3 and 9 o'clock) and beyond: never all in
+/// one ear, so that a wearer who hears on one side only (or wears one earpiece) still hears it.
+float cue_pan(const CueEvent& e);
+constexpr float kMaxPan = 0.8f;
 
 /// The cue as one token for the frame lines, e.g. "stairs_ahead_up:3m@2", "count:5", "tick".
 std::string token(const CueEvent& e);

@@ -15,8 +15,21 @@
 ///   (even within `repeat_time`).
 /// - Blind: no floor and nothing seen nor tracked for `blind_after` s: told once, then every
 ///   `blind_repeat` s while it lasts.
+/// - Approach: a confirmed descending staircase whose first edge is within `approach_range` m
+///   beeps (kApproach, an earcon and a pulse), again and again, the interval shrinking linearly
+///   from `approach_interval_far` s at the range to `approach_interval_near` s at `approach_near` m
+///   (parking-sensor style; the distance is the nearest of this approach after a 5-frame median,
+///   so a noisy reading never slows the beat while the wearer walks on). It stops on the first
+///   step, when the edge's bearing leaves the `approach_cone` (turned away), when the wearer has
+///   not come 0.15 m nearer for `approach_stall` s (stopped; it resumes on walking on), and when
+///   the staircase is forgotten. At every verbosity. The drop warning counts as a beat (no beep over
+///   its alarm; the next beep keeps the interval from it).
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
 ///   steps left, last step, end) follow its states; without it only the detection cues are given.
+///
+/// - System state, at every verbosity: battery low and critical (battery()), and "slow" once
+///   perception has been more than `slow_lag` s behind the camera (`lag_s`) for `slow_after` s,
+///   again every `slow_repeat` s while it lasts (over when the lag falls below half `slow_lag`).
 ///
 /// Verbosity: quiet = warnings (drop, last step, blind, camera) and earcons for stairs and steps
 /// ahead; normal = the words for what is ahead, first step, ticks, counts every `count_interval`
@@ -41,6 +54,7 @@ struct CueInput {
   bool floor_found = false;   ///< the floor is seen in this frame
   StairSummary stair;         ///< this frame's detection
   TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
+  double lag_s = 0.0;         ///< s from the frame's capture to this decision (perception behind)
 };
 
 /// Clock position (1..12, 12 straight ahead, 3 to the right) of a bearing in rad; 12 for NaN.
@@ -57,6 +71,11 @@ class CuePolicy {
   /// The camera stopped sending / is back (`t`: time of the last frame seen, s).
   std::vector<CueEvent> camera_lost(double t);
   std::vector<CueEvent> camera_back(double t);
+  /// The battery as last read (power_supply.hpp), at frame time `t`: "battery low" when the charge
+  /// falls to `battery_low` (not charging), again every `battery_repeat` s while it lasts;
+  /// "battery critical" at `battery_critical`, every `battery_critical_repeat` s. Charging, or a
+  /// charge 3 points above the low mark, ends it (told again on the next fall).
+  std::vector<CueEvent> battery(double t, bool present, float charge, bool charging);
 
  private:
   struct Sighting {
@@ -89,6 +108,8 @@ class CuePolicy {
   void detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out);
   void flight_cues(const TraversalResult& tr, double t, std::vector<CueEvent>& out);
   void blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out);
+  void approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out);
+  float approach_interval(float d) const;
 
   FeedbackConfig cfg_;
   Verbosity verbosity_ = Verbosity::kNormal;
@@ -101,11 +122,25 @@ class CuePolicy {
   int prev_climbed_ = 0;
   bool steps_left_told_ = false;
   double last_tick_t_ = -1e9;
+  // Approach beep (to a descending first edge).
+  struct Approach {
+    bool on = false;             // within range, ahead, walking: beeping
+    double last_beep_t = -1e9;
+    float nearest = 0.f;         // m, the nearest (filtered) distance of this approach
+    float ref_d = 0.f;           // m, distance when the wearer last came 0.15 m nearer ...
+    double ref_t = 0.0;          // ... and when
+    float recent[5] = {};        // the last distances, for the median
+    int n_recent = 0;
+  };
+  Approach approach_;
   // Blind.
   double blind_since_ = -1.0;
   double last_blind_t_ = -1e9;
   double last_frame_t_ = -1e9;
-  double last_t_[16] = {};  // per Cue, the last time it was given
+  double last_t_[kCueKinds] = {};  // per Cue, the last time it was given
+  // System state.
+  int battery_told_ = 0;  // 0 nothing, 1 low, 2 critical: the level told of this fall
+  double slow_since_ = -1.0;
 };
 
 }  // namespace stairguide::feedback

@@ -8,6 +8,8 @@
 ///   tick, first step, count: one short pulse          last step: one long pulse
 ///   end of stairs: two short                          drop warning (danger): five fast pulses
 ///   blind, camera lost: three long                    ready, camera back: one medium
+///   approach (to a descent's edge): one sharp 40 ms pulse per beep, the beeps closer as it nears
+///   battery low: two of 200 ms                         battery critical: four of 200 ms
 ///
 /// Lines: `GpiodLine` (libgpiod 1.6), `FileLine` (writes every edge to a file: the daemon's test
 /// backend, gpio_chip "file:PATH"), `RecordingLine` (a fake: edges with their times, in memory).

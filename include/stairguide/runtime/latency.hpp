@@ -4,6 +4,7 @@
 /// exact to a bin, over a run of any length. Not thread-safe.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace stairguide::runtime {
@@ -29,6 +30,20 @@ class LatencyHistogram {
   std::uint64_t count_ = 0;
   double sum_ = 0.0;
   double max_ = 0.0;
+};
+
+/// The cue latency of one cue kind over a run: capture of the frame that warranted the cue -> its
+/// first sample handed to the sound device (a cue said in one phrase with others of its frame
+/// counts from the phrase's first sample; a step cue told by an earcon, from the earcon's).
+struct CueKindLatency {
+  std::string kind;                 ///< feedback::to_string(Cue): "tick", "count", ...
+  std::uint64_t given = 0;          ///< cues of this kind given by the policy
+  std::uint64_t sounded = 0;        ///< of them, started on the sound device
+  std::uint64_t late = 0;           ///< started after the next step's frame (its step had passed)
+  std::vector<double> samples_ms;   ///< every latency measured, in the order started
+  /// The feedback path's share of each: the decision on the frame -> its first sample handed
+  /// (the rest is capture -> decision, the stages' time).
+  std::vector<double> from_decision_ms;
 };
 
 }  // namespace stairguide::runtime

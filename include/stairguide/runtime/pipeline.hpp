@@ -21,6 +21,7 @@
 
 #include "stairguide/core/config.hpp"
 #include "stairguide/core/types.hpp"
+#include "stairguide/runtime/latency.hpp"
 #include "stairguide/stairs/traversal_result.hpp"
 
 namespace stairguide {
@@ -164,6 +165,7 @@ class FeedbackStage {
     std::uint64_t lost = 0;     ///< of them, dropped unplayed (the sound device could not take them)
     double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
     std::string last;  ///< token of the last cue given ("" none)
+    std::vector<CueKindLatency> by_kind;  ///< per cue kind given at least once, in Cue order
   };
   CueLatency cue_latency() const;  ///< any thread
   void clear_cue_latency();         ///< forgets the latencies measured so far (benchmarks)

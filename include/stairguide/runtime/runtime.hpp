@@ -30,6 +30,7 @@
 
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/core/config.hpp"
+#include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/notifier.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 
@@ -118,6 +119,7 @@ struct RuntimeStats {
   double cue_latency_p50_ms = 0.0; ///< capture of the frame warranting a cue -> its first sample out
   double cue_latency_p99_ms = 0.0;
   std::string last_cue;            ///< token of the last cue ("" none)
+  std::vector<CueKindLatency> cue_kinds;  ///< the cue latency per cue kind (FeedbackStage)
   /// The traversal as of the last decision (issue 32): state token, step the user stands on,
   /// steps left (-1 unknown), steps known.
   std::string traversal_state = "-";

@@ -5,6 +5,9 @@
 //      odometry (odometry_frames_lost must be 0);
 //   3. real-time replay at the recording's 30 Hz, threaded: capture-to-decision latency p50/p99 and
 //      the share of frames perception skipped.
+//   --cues: only the cue latency per cue kind over the synthetic walks (climbs and descents), each
+//      replayed from memory at its 30 Hz: capture of the frame warranting a cue -> its first sample
+//      handed to the sound device, p50/p99/max per kind, and the cues heard after their step passed.
 //   4. the cue path: the feedback stage driven at 30 Hz with a cue (a step tick) every third frame,
 //      from the decision to the cue's first sample handed to the sound device (`--audio DEV`,
 //      default ALSA's "null"; the buzzer is off in every run).
@@ -12,8 +15,11 @@
 // cue_latency_p50_ms / cue_latency_p99_ms (3: capture of the frame warranting a cue -> its first
 // sample out), odometry_frames_lost (2 + 3); each run in full under "fast", "realtime",
 // "reference", "cue_path".
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <filesystem>
 #include <thread>
 #include <memory>
@@ -151,8 +157,113 @@ runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int fr
   return stage.cue_latency();
 }
 
+/// The cue latency per cue kind as a wearer meets it: each synthetic walk (climbs and descents)
+/// held in memory and replayed threaded at its 30 Hz (the runtime paces the frames by their
+/// timestamps, so the cues' clock is the sensor's), cues to `config.feedback.audio_device`.
+int bench_cues(const PipelineConfig& config, const std::vector<std::string>& walks, bool json) {
+  struct Acc {
+    std::uint64_t given = 0, sounded = 0, late = 0;
+    std::vector<double> ms, dms;
+  };
+  std::vector<std::pair<std::string, Acc>> kinds;  // in the order first met
+  auto acc_of = [&](const std::string& k) -> Acc& {
+    for (auto& [n, a] : kinds)
+      if (n == k) return a;
+    kinds.push_back({k, Acc{}});
+    return kinds.back().second;
+  };
+  std::vector<double> decision_ms;  // capture -> decision over all walks' frames (the stages' share)
+  std::string per_walk;
+  for (const auto& walk : walks) {
+    auto src = open_frame_source("synth:" + walk, config.capture);
+    const CameraIntrinsics k = src->intrinsics();
+    const std::string desc = src->describe();
+    auto frames = std::make_shared<std::vector<RgbdFrame>>();
+    if (!json) std::fprintf(stderr, "bench daemon --cues: %s: rendering...\n", walk.c_str());
+    for (;;) {
+      RgbdFrame f;
+      const ReadResult r = src->read(f);
+      if (r.status == ReadStatus::kEnd) break;
+      if (!r.ok()) throw std::runtime_error(r.message);
+      frames->push_back(std::move(f));
+    }
+    src.reset();
+    const long n = static_cast<long>(frames->size());
+    if (!json) std::fprintf(stderr, "bench daemon --cues: %s: %ld frames at 30 Hz (%.0f s)...\n", walk.c_str(), n, n / 30.0);
+    const Run r = run_once(config, frames, k, desc, n, true, false);
+    frames.reset();
+    std::uint64_t walk_cues = 0, walk_late = 0;
+    double walk_max = 0.0;
+    for (const auto& c : r.stats.cue_kinds) {
+      Acc& a = acc_of(c.kind);
+      a.given += c.given;
+      a.sounded += c.sounded;
+      a.late += c.late;
+      a.ms.insert(a.ms.end(), c.samples_ms.begin(), c.samples_ms.end());
+      a.dms.insert(a.dms.end(), c.from_decision_ms.begin(), c.from_decision_ms.end());
+      walk_cues += c.given;
+      walk_late += c.late;
+      for (double v : c.samples_ms) walk_max = std::max(walk_max, v);
+    }
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%s{\"walk\": \"%s\", \"frames\": %ld, \"cues\": %llu, \"late\": %llu, \"cue_latency_max_ms\": %.1f, "
+                  "\"decision_latency_p99_ms\": %.1f, \"perception_drop_rate\": %.4f}",
+                  per_walk.empty() ? "" : ", ", walk.c_str(), n, static_cast<unsigned long long>(walk_cues),
+                  static_cast<unsigned long long>(walk_late), walk_max, r.stats.latency_p99_ms,
+                  r.stats.perception_drop_rate);
+    per_walk += line;
+    if (!json)
+      std::printf("%-22s %5ld frames  cues %3llu  late %llu  cue latency max %7.1f ms  capture->decision p99 %6.1f ms  "
+                  "perception skipped %.1f%%\n",
+                  walk.c_str(), n, static_cast<unsigned long long>(walk_cues), static_cast<unsigned long long>(walk_late),
+                  walk_max, r.stats.latency_p99_ms, 100.0 * r.stats.perception_drop_rate);
+  }
+  auto pct = [](std::vector<double> v, double p) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const auto rank = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(p / 100.0 * v.size())));
+    return v[rank - 1];
+  };
+  bool pass = true;
+  std::string kinds_json;
+  std::vector<double> all;
+  std::uint64_t late = 0;
+  for (const auto& [name, a] : kinds) {
+    const double p50 = pct(a.ms, 50), p99 = pct(a.ms, 99);
+    const double mx = a.ms.empty() ? 0.0 : *std::max_element(a.ms.begin(), a.ms.end());
+    all.insert(all.end(), a.ms.begin(), a.ms.end());
+    late += a.late;
+    if (!a.ms.empty() && p99 > 100.0) pass = false;
+    char b[512];
+    const double d50 = pct(a.dms, 50), d99 = pct(a.dms, 99);
+    std::snprintf(b, sizeof b, "%s\"%s\": {\"given\": %llu, \"sounded\": %llu, \"late\": %llu, \"p50_ms\": %.1f, \"p99_ms\": %.1f, \"max_ms\": %.1f, "
+                  "\"from_decision_p50_ms\": %.1f, \"from_decision_p99_ms\": %.1f}",
+                  kinds_json.empty() ? "" : ", ", name.c_str(), static_cast<unsigned long long>(a.given),
+                  static_cast<unsigned long long>(a.sounded), static_cast<unsigned long long>(a.late), p50, p99, mx, d50, d99);
+    kinds_json += b;
+    if (!json)
+      std::printf("  %-14s given %4llu  sounded %4llu  late %3llu  p50 %7.1f ms  p99 %7.1f ms  max %7.1f ms   "
+                  "(decision -> sound p50 %6.1f p99 %6.1f ms)\n", name.c_str(),
+                  static_cast<unsigned long long>(a.given), static_cast<unsigned long long>(a.sounded),
+                  static_cast<unsigned long long>(a.late), p50, p99, mx, d50, d99);
+  }
+  if (late > 0) pass = false;
+  if (json)
+    std::printf("{\"cue_latency_p50_ms\": %.1f, \"cue_latency_p99_ms\": %.1f, \"late\": %llu, \"kinds\": {%s},\n \"walks\": [%s]}\n",
+                pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), kinds_json.c_str(), per_walk.c_str());
+  else
+    std::printf("all cues: p50 %.1f ms p99 %.1f ms, %llu late; target p99 <= 100 ms for every kind and none late: %s\n",
+                pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), pass ? "PASS" : "FAIL");
+  return 0;
+}
+
 int bench_daemon(Context& ctx) {
   const bool json = ctx.flag("--json");
+  const bool cues_only = ctx.flag("--cues");
+  const std::string walks_arg =
+      ctx.option("--walks").value_or("climb_3_steps,climb_8_steps,climb_14_steps,climb_8_pause_turn,climb_8_person,"
+                                     "descend_3_steps,descend_8_steps,descend_14_steps,descend_8_pause_turn,descend_8_person");
   const bool skip_realtime = ctx.flag("--no-realtime");
   const long frames_wanted = ctx.int_option("--frames", 1, 100000).value_or(600);
   const long reference_frames = ctx.int_option("--reference-frames", 0, 100000).value_or(150);
@@ -171,6 +282,14 @@ int bench_daemon(Context& ctx) {
   config.feedback.haptic_enabled = false;
   if (!std::filesystem::exists(config.feedback.sounds_dir))
     config.feedback.sounds_dir = std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds";
+
+  if (cues_only) {
+    std::vector<std::string> walks;
+    std::stringstream ws(walks_arg);
+    for (std::string w; std::getline(ws, w, ',');)
+      if (!w.empty()) walks.push_back(w);
+    return bench_cues(config, walks, json);
+  }
 
   auto src = open_frame_source(input, config.capture);
   const std::string desc = src->describe();
@@ -248,8 +367,11 @@ int bench_daemon(Context& ctx) {
 
 }  // namespace
 
-SG_BENCH("daemon", "daemon [--json] [--frames N] [--reference-frames N] [--no-realtime] [--audio DEV] [INPUT]",
-         "the daemon's threads: fast and 30 Hz replay (fps, latency p50/p99, drops) vs one thread",
+SG_BENCH("daemon",
+         "daemon [--json] [--frames N] [--reference-frames N] [--no-realtime] [--audio DEV] [INPUT] | "
+         "daemon --cues [--walks W,W..] [--audio DEV] [--json]",
+         "the daemon's threads: fast and 30 Hz replay (fps, latency p50/p99, drops) vs one thread; --cues: "
+         "cue latency per cue kind over the synthetic climbs and descents at 30 Hz",
          bench_daemon);
 
 }  // namespace stairguide::cli
