@@ -231,7 +231,9 @@ TEST(E2eFeedback, ClimbIsToldStepByStep) {
   EXPECT_EQ(std::count(told.begin(), told.end(), "last_step"), 1);
   EXPECT_EQ(std::count(told.begin(), told.end(), "end_of_stairs"), 1);
   EXPECT_EQ(std::count(told.begin(), told.end(), "stairs_ahead_down"), 0);
-  const auto names = sgtest::names_of(sgtest::heard(r.audio, kStairClips));
+  // A step's tick mixed over the tail of the phrase before it lowers that tail by 6 dB (it is
+  // still heard): the milestones are matched at 0.85, words of other clips score far below that.
+  const auto names = sgtest::names_of(sgtest::heard(r.audio, kStairClips, 0.85));
   std::printf("climb_8_steps: heard %s\n", ::testing::PrintToString(names).c_str());
   std::vector<std::string> order;  // the spoken milestones, in the order heard
   for (const auto& n : names)

@@ -10,8 +10,9 @@ StairVerdict check_walkable(const StairDimensions& d, float tolerance, float tol
   if (d.riser < limits.riser_min - tolerance || d.riser > limits.riser_max + tolerance)
     return StairVerdict::kRiserOutOfRange;
   if (d.tread_known && d.tread < limits.tread_min - tread_tol) return StairVerdict::kTreadTooShort;
-  // A width cut by the image border is a lower bound: only half the minimum is asked of it.
-  const float width_min = d.width_complete ? limits.width_min : 0.5f * limits.width_min;
+  if (d.tread_known && d.tread > limits.tread_max + tread_tol) return StairVerdict::kTreadTooLong;
+  // A width cut by the image border is a lower bound: less is asked of it.
+  const float width_min = d.width_complete ? limits.width_min : limits.width_cut_min;
   if (d.width < width_min - tolerance) return StairVerdict::kTooNarrow;
   return StairVerdict::kDetected;
 }

@@ -28,6 +28,7 @@ const char* to_string(StairVerdict v) {
     case StairVerdict::kTooNarrow: return "too narrow to walk";
     case StairVerdict::kInconsistentEdges: return "step edges not evenly spaced";
     case StairVerdict::kStackedLevels: return "a level stands on the one below it (an object on a surface)";
+    case StairVerdict::kTreadTooLong: return "levels farther apart than a stride (not one flight)";
   }
   return "unknown";
 }
@@ -42,6 +43,16 @@ StairStage::StairStage(const ClassificationConfig& classification, const StairDe
 namespace {
 
 void reset(StairResult& r, StairVerdict v, int candidates) { r.clear(v, candidates); }
+
+using Clock = std::chrono::steady_clock;
+
+/// Detection from t0 to t1, modelling from t1 to t2.
+void set_timings(StairResult& r, Clock::time_point t0, Clock::time_point t1, Clock::time_point t2) {
+  auto ms = [](Clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
+  r.timings.detection_ms = ms(t1 - t0);
+  r.timings.modelling_ms = ms(t2 - t1);
+  r.timings.total_ms = ms(t2 - t0);
+}
 
 /// True when `a` is the better answer for the user than `b`.
 bool better(const StairResult& a, const StairResult& b) {
@@ -64,11 +75,7 @@ void StairStage::run(const SceneResult& scene, const CameraIntrinsics* K, StairR
     floorless_.run(scene, K, out);
     // Without a stack of levels the reason stays "no floor"; a rejected stack says why.
     if (!out.detected && out.levels < 2) out.verdict = StairVerdict::kNoFloor;
-    const auto t2 = clock::now();
-    auto ms = [](clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
-    out.timings.detection_ms = ms(t1 - t0);
-    out.timings.modelling_ms = ms(t2 - t1);
-    out.timings.total_ms = ms(t2 - t0);
+    set_timings(out, t0, t1, clock::now());
     return;
   }
   reset(up_, d.ascending.verdict, d.ascending.candidates);
@@ -92,11 +99,7 @@ void StairStage::run(const SceneResult& scene, const CameraIntrinsics* K, StairR
     floorless_.run(scene, K, out);
     if (out.detected) {
       reset(other_, StairVerdict::kFloorDoubtful, d.candidates);
-      const auto t2f = clock::now();
-      auto ms = [](clock::duration x) { return std::chrono::duration<double, std::milli>(x).count(); };
-      out.timings.detection_ms = ms(t1 - t0);
-      out.timings.modelling_ms = ms(t2f - t1);
-      out.timings.total_ms = ms(t2f - t0);
+      set_timings(out, t0, t1, clock::now());
       return;
     }
   }

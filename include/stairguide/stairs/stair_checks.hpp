@@ -18,12 +18,14 @@
 namespace stairguide {
 
 /// What a human foot and leg can walk (physics, not a code, so not in the config). The ranges are
-/// the physical range: risers 5-25 cm, goings from 15 cm, width from 0.4 m.
+/// the physical range: risers 5-25 cm, goings 15-60 cm, width from 0.4 m.
 struct WalkableLimits {
   float riser_min = 0.05f;   ///< m, lower than this is no step (a threshold, a rug)
   float riser_max = 0.25f;   ///< m, higher than this is no step one climbs (a ledge, a seat)
   float tread_min = 0.15f;   ///< m, a level shallower than this cannot hold a foot
+  float tread_max = 0.60f;   ///< m, levels farther apart than a stride are no flight's consecutive steps
   float width_min = 0.40f;   ///< m, narrower than this is no way for a body
+  float width_cut_min = 0.30f;  ///< m, a width cut by the view (a lower bound) must still reach this
 };
 
 /// Measured dimensions of a modelled staircase, as the checks need them.
@@ -37,7 +39,8 @@ struct StairDimensions {
 };
 
 /// Physical walkability: kDetected, or the physical reason it cannot be walked
-/// (kRiserOutOfRange: not a step's rise; kTreadTooShort: cannot hold a foot; kTooNarrow).
+/// (kRiserOutOfRange: not a step's rise; kTreadTooShort: cannot hold a foot; kTreadTooLong:
+/// farther apart than a stride; kTooNarrow).
 /// `tolerance` is the measurement slack (m), `tolerance_per_m2` its growth with the range.
 StairVerdict check_walkable(const StairDimensions& d, float tolerance, float tolerance_per_m2,
                             const WalkableLimits& limits = WalkableLimits{});

@@ -38,7 +38,8 @@ enum class StairVerdict {
   kBlondelOutOfRange, ///< unused since issue 39: 2R+T only describes (StairResult::code_notes)
   kTooNarrow,         ///< too narrow for a body (stair_checks.hpp: under 0.4 m)
   kInconsistentEdges, ///< step edges not evenly spaced (not a staircase)
-  kStackedLevels      ///< a level stands on the one below it (a box on a shelf board), not a step
+  kStackedLevels,     ///< a level stands on the one below it (a box on a shelf board), not a step
+  kTreadTooLong       ///< consecutive levels farther apart than a stride (stair_checks.hpp: 60 cm): no flight
 };
 /// Short human-readable reason ("no floor", "tread too short", ...).
 const char* to_string(StairVerdict v);
