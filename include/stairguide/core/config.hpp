@@ -528,7 +528,7 @@ struct StairModellingConfig {
     v.num(tread_min, "tread_min_cm", Unit::kCentimetre, 1, 200, "building code described: shortest tread (under it: \"steep\")");
     v.num(blondel_min, "blondel_min_cm", Unit::kCentimetre, 10, 300, "building code described: lowest 2R+T");
     v.num(blondel_max, "blondel_max_cm", Unit::kCentimetre, 10, 300, "building code described: highest 2R+T");
-    v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "building code described: narrowest staircase (what cannot be walked is fixed: rise 5-25 cm, tread >= 15 cm, width >= 40 cm)");
+    v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "building code described: narrowest staircase (what cannot be walked is fixed: rise 5-25 cm, tread >= 15 cm, width >= 50 cm)");
     v.num(manhattan_min_fraction, "manhattan_min_percent", Unit::kPercent, 0, 100,
           "share of Manhattan points needed to take the stair axes from the Manhattan frame");
     v.num(manhattan_max_disagreement, "manhattan_max_disagreement_deg", Unit::kDegree, 0, 45,

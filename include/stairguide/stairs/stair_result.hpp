@@ -36,7 +36,7 @@ enum class StairVerdict {
   kRiserOutOfRange,   ///< riser outside what a leg climbs (stair_checks.hpp: 5-25 cm), not a step
   kTreadTooShort,     ///< tread too shallow to hold a foot (stair_checks.hpp: under 15 cm)
   kBlondelOutOfRange, ///< unused since issue 39: 2R+T only describes (StairResult::code_notes)
-  kTooNarrow,         ///< too narrow for a body (stair_checks.hpp: under 0.4 m)
+  kTooNarrow,         ///< too narrow for a body (stair_checks.hpp: under 0.5 m)
   kInconsistentEdges, ///< step edges not evenly spaced (not a staircase)
   kStackedLevels,     ///< a level stands on the one below it (a box on a shelf board), not a step
   kTreadTooLong       ///< consecutive levels farther apart than a stride (stair_checks.hpp: 60 cm): no flight
