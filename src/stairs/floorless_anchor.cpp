@@ -23,7 +23,7 @@ float FloorlessStairs::seen_floor_height(int dir, float riser) const {
     if (std::find(chain_.begin(), chain_.end(), i) != chain_.end()) continue;
     const Node& f = nodes_[static_cast<std::size_t>(i)];
     const float cam_above = -f.height;
-    if (cam_above < floor_.usual_height_min - tol || cam_above > floor_.usual_height_max + tol) continue;
+    if (cam_above < floor_.height_min - tol || cam_above > floor_.height_max + tol) continue;
     // On the user's side of the flight: below its first level ascending, above it descending.
     const float a0 = static_cast<float>(dir) * (h0 - f.height);
     const int k = static_cast<int>(std::lround(a0 / riser));

@@ -85,20 +85,25 @@ void FloorlessStairs::decide_first_level(const SceneResult& scene, const CameraI
   const float floor_depth = chest_view && out.tread_m > 0.f ? out.tread_m + kFloorDepthSlack
                                                              : std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
   const bool deep = depth > floor_depth;
-  const bool floor_height = cam_above >= floor_.usual_height_min - det_.same_level_tolerance &&
-                            cam_above <= floor_.usual_height_max + det_.same_level_tolerance;
+  const bool floor_height = cam_above >= floor_.height_min - det_.same_level_tolerance &&
+                            cam_above <= floor_.height_max + det_.same_level_tolerance;
   if (chest_view && !floor_height) return;
   // The other way round: were the level a first tread, the user's floor would lie one riser
   // below it (ascending) or above it (descending); outside a chest camera's height range that
   // cannot be the user's floor, so the level is.
   const float tread_cam = cam_above + static_cast<float>(dir) * out.riser_m;
-  const bool tread_height = tread_cam >= floor_.usual_height_min - det_.same_level_tolerance &&
-                            tread_cam <= floor_.usual_height_max + det_.same_level_tolerance;
+  const bool tread_height = tread_cam >= floor_.height_min - det_.same_level_tolerance &&
+                            tread_cam <= floor_.height_max + det_.same_level_tolerance;
   if (!deep && (!chest_view || tread_height)) {
     // Seen from a wearer's rig (its tilt range) the staircase is told, its first step unknown. A
     // camera held level (a hand-held or tripod view, no wearer) keeps the old refusal: its model
     // of a floor strip and open treads came out inconsistent (treads of -39 to 70 cm).
     const bool rig_view = trace_.tilt >= floor_.tilt_min && trace_.tilt <= floor_.tilt_max;
+    // Two levels only: taken as the floor and one step, the single-level case would need the real
+    // floor (paper 4.1) and say nothing; a person sees a flight's nosings. The stack stays as
+    // modelled (the first level a tread), without_floor.
+    const int levels = static_cast<int>(chain_.size());
+    if (rig_view && levels - 1 < std::max(2, det_.floorless_min_levels)) return;
     // Modelled on the first level as the floor, the origin lies on a true edge whichever it is:
     // the level's far side is riser 1 if it is the floor, riser 2 if it is the first tread. The
     // count is what stays unknown.

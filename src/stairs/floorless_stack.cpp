@@ -238,7 +238,7 @@ FloorlessStairs::StackDirection FloorlessStairs::stack_direction() {
       votes_down >= std::max(2, n - 3)) {
     const float cam_above = -nodes_[static_cast<std::size_t>(chain_.back())].height;
     const float tol = det_.same_level_tolerance;
-    if (cam_above >= floor_.usual_height_min - tol && cam_above <= floor_.usual_height_max + tol) {
+    if (cam_above >= floor_.height_min - tol && cam_above <= floor_.height_max + tol) {
       trace_.floor_beside = true;
       chain_.pop_back();
       trace_.level_heights.pop_back();
