@@ -59,7 +59,7 @@ void render_into(const Scene& scene, const WalkerState& walker, long index, std:
                  const SynthOptions& o, RenderBuffers& buf, RgbdFrame& frame, FrameTruth& truth) {
   const CameraIntrinsics K = synthetic_intrinsics(o);
   render(scene, walker.T_world_camera, K, buf, true);
-  const std::uint64_t noise_seed = mix_seed(seed, static_cast<std::uint64_t>(index), 0xD3);
+  const std::uint64_t noise_seed = mix_seed(seed, static_cast<std::uint64_t>(index), 0xD3 + o.noise_salt);
   apply_depth_sensor(buf, K, o, noise_seed, frame.depth);
   apply_color_sensor(buf, o, noise_seed, frame.color, frame.gray);
   frame.index = static_cast<std::uint64_t>(index);

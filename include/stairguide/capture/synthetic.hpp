@@ -64,6 +64,9 @@ struct SynthOptions {
   float camera_height_m = std::numeric_limits<float>::quiet_NaN();
   float camera_tilt_deg = std::numeric_limits<float>::quiet_NaN();
   float camera_roll_deg = std::numeric_limits<float>::quiet_NaN();
+  /// Draws the sensor noise afresh for the same view (0: the frame's own noise): a wearer standing
+  /// still sees one scene through a new noise on every frame.
+  std::uint32_t noise_salt = 0;
 
   // ---- sensor model (Kinect v1 class); the range limits apply even with noise off ----
   float min_range_m = 0.5f;          ///< m, nearer surfaces give no reading

@@ -1,0 +1,127 @@
+// A wearer standing still at a staircase (issue 39, "the floor of a standing wearer"): any rig in
+// range (0.5-1.8 m, 15-80 deg), nothing learned before, the flight in view from the first frame.
+// The daemon's own perception stage (runtime::PerceptionStage, as in --sync) sees the same view
+// frame after frame, each through fresh sensor noise; within 30 frames (one second) it must have
+// the floor and the staircase, placed where it is.
+//
+// StandingWearer.FloorAndStairsWithinASecond runs a grid small enough for CI (seed 4301, never
+// tuned on). DISABLED_Measure is the issue's figure: SG_STANDING_SEEDS (default "4301 4302"),
+// SG_STANDING_VIEWS (default 3) views per flight preset, on every rig of the grid below.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/perception/scene.hpp"
+#include "stairguide/runtime/pipeline.hpp"
+#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/stairs/stair_result.hpp"
+
+namespace {
+
+using namespace stairguide;
+
+constexpr long kFrames = 30;  // one second at the sensor's pace
+
+struct Rig {
+  float height_m, tilt_deg;
+};
+
+/// What became of one (rig, flight) pair.
+struct PairOutcome {
+  bool in_view = false;  ///< two or more whole steps of the flight in view (truth)
+  int first_frame = -1;  ///< first frame with the floor and the flight (a true positive); -1 none
+  bool held = false;     ///< and still so on the last frame
+  std::string last;      ///< the last frame's state, for the report
+};
+
+PairOutcome stand(const PipelineConfig& cfg, const std::string& preset, long view, std::uint32_t seed, Rig rig,
+                  synth::RealSensor sensor) {
+  synth::SynthOptions o = synth::with_real_artefacts(sensor);
+  o.camera_height_m = rig.height_m;
+  o.camera_tilt_deg = rig.tilt_deg;
+  runtime::PerceptionStage stage(cfg);
+  RgbdFrame frame;
+  FrameTruth truth;
+  PairOutcome out;
+  for (long k = 0; k < kFrames; ++k) {
+    o.noise_salt = static_cast<std::uint32_t>(k);
+    synth::render_preset_frame(preset, view, seed, o, frame, truth);
+    frame.index = static_cast<std::uint64_t>(k);
+    frame.timestamp = static_cast<double>(k) / 30.0;
+    const runtime::PerceptionOutput p = stage.step(frame, static_cast<std::uint64_t>(k), {});
+    const StairFrameEval e = evaluate_stair_frame(stage.last_stair(), truth);
+    if (k == 0) {
+      out.in_view = e.fully_visible;
+      if (!out.in_view) return out;  // a rig that does not see the flight: not a pair
+    }
+    const bool ok = p.floor_found && e.outcome == EvalOutcome::kTP;
+    if (ok && out.first_frame < 0) out.first_frame = static_cast<int>(k);
+    out.held = ok;
+    out.last = p.state + " (" + p.detail + ")";
+  }
+  return out;
+}
+
+struct Tally {
+  int pairs = 0, told = 0;
+  void add(const PairOutcome& o, const char* what) {
+    if (!o.in_view) return;
+    ++pairs;
+    const bool good = o.first_frame >= 0 && o.held;
+    told += good;
+    if (!good) std::printf("standing: MISSED %s: first %d, last frame %s\n", what, o.first_frame, o.last.c_str());
+  }
+};
+
+void run_grid(Tally& t, const std::vector<Rig>& rigs, const std::vector<std::uint32_t>& seeds, long views) {
+  const PipelineConfig cfg;
+  for (std::uint32_t seed : seeds)
+    for (const Rig& rig : rigs)
+      for (const char* preset : {"world_ascending_static", "world_descending_static", "world2_lowrig_static"})
+        for (long v = 0; v < views; ++v) {
+          const synth::RealSensor sensor = (v + seed) % 2 ? synth::RealSensor::kKinectV1 : synth::RealSensor::kKinectV2;
+          const PairOutcome o = stand(cfg, preset, v, seed, rig, sensor);
+          char what[160];
+          std::snprintf(what, sizeof what, "rig %.1f m %.0f deg, %s #%ld seed %u", rig.height_m, rig.tilt_deg,
+                        preset, v, seed);
+          t.add(o, what);
+        }
+}
+
+std::vector<std::uint32_t> env_seeds(const char* name, std::vector<std::uint32_t> dflt) {
+  const char* s = std::getenv(name);
+  if (!s) return dflt;
+  std::vector<std::uint32_t> v;
+  std::istringstream in(s);
+  for (unsigned x; in >> x;) v.push_back(x);
+  return v.empty() ? dflt : v;
+}
+
+TEST(StandingWearer, FloorAndStairsWithinASecond) {
+  // Low and high rigs, shallow and steep tilts: the corners of the range and the waist rig.
+  const std::vector<Rig> rigs = {{0.6f, 25.f}, {0.6f, 50.f}, {0.9f, 35.f}, {1.3f, 45.f}, {1.8f, 20.f}, {1.8f, 70.f}};
+  Tally t;
+  run_grid(t, rigs, {4301u}, 1);
+  std::printf("standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames\n",
+              t.told, t.pairs, kFrames);
+  ASSERT_GE(t.pairs, 6) << "too few rigs see a flight: the grid tests nothing";
+  EXPECT_GE(t.told, t.pairs - 1);
+}
+
+TEST(StandingWearer, DISABLED_Measure) {
+  std::vector<Rig> rigs;
+  for (float h : {0.5f, 0.8f, 1.1f, 1.4f, 1.8f})
+    for (float tilt : {15.f, 35.f, 55.f, 80.f}) rigs.push_back({h, tilt});
+  const char* v = std::getenv("SG_STANDING_VIEWS");
+  Tally t;
+  run_grid(t, rigs, env_seeds("SG_STANDING_SEEDS", {4301u, 4302u}), v ? std::atol(v) : 3);
+  std::printf("standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames (%.1f%%)\n",
+              t.told, t.pairs, kFrames, t.pairs ? 100.0 * t.told / t.pairs : 0.0);
+}
+
+}  // namespace
