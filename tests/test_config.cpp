@@ -186,16 +186,14 @@ TEST(Config, InconsistentPairIsRejected) {
   EXPECT_NE(e.find("floor.height_max_m"), std::string::npos) << e;
 }
 
-TEST(Config, RiserHeightsAndGoingsMustBeOrdered) {
-  const std::string h =
-      error_of("riser_h", "manhattan:\n  riser_min_height_cm: 25\n  riser_max_height_cm: 20\n");
-  EXPECT_NE(h.find("manhattan.riser_min_height_cm must not exceed manhattan.riser_max_height_cm"),
-            std::string::npos)
-      << h;
-  const std::string g = error_of("riser_g", "manhattan:\n  riser_going_min_cm: 70\n");
-  EXPECT_NE(g.find("manhattan.riser_going_min_cm must not exceed manhattan.riser_going_max_cm"),
-            std::string::npos)
-      << g;
+TEST(Config, FixedThresholdsOfTheMethodAreNoKeys) {
+  // The method's own thresholds (the floor detector's tread and curb checks, the Manhattan frame's
+  // wall rules...) are named constants with units in config.hpp, not keys a technician sets: a file
+  // that names one is refused, the key named, like any unknown key.
+  const std::string e = error_of("fixed", "manhattan:\n  riser_min_height_cm: 25\n");
+  EXPECT_NE(e.find("manhattan.riser_min_height_cm"), std::string::npos) << e;
+  const std::string f = error_of("fixed2", "floor:\n  ambiguous_rise_min_cm: 10\n");
+  EXPECT_NE(f.find("floor.ambiguous_rise_min_cm"), std::string::npos) << f;
 }
 
 TEST(Config, MissingFileIsNamed) {
@@ -340,11 +338,11 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
     const char* what;
   };
   const Case cases[] = {
-      {"floor:\n  ambiguous_rise_min_cm: 30\n  ambiguous_rise_max_cm: 20\n",
-       ":3: key 'floor.ambiguous_rise_max_cm'",
-       "floor.ambiguous_rise_min_cm must not exceed floor.ambiguous_rise_max_cm"},
-      {"floor:\n  curb_rise_max_cm: 4\n  curb_rise_min_cm: 8\n", ":3: key 'floor.curb_rise_min_cm'",
-       "floor.curb_rise_min_cm must not exceed floor.curb_rise_max_cm"},
+      {"floor:\n  usual_height_min_m: 1.4\n  usual_height_max_m: 1.2\n",
+       ":3: key 'floor.usual_height_max_m'",
+       "floor.usual_height_min_m must not exceed floor.usual_height_max_m"},
+      {"floor:\n  usual_tilt_max_deg: 30\n  usual_tilt_min_deg: 40\n", ":3: key 'floor.usual_tilt_min_deg'",
+       "floor.usual_tilt_min_deg must not exceed floor.usual_tilt_max_deg"},
       {"stair_detection:\n  floorless_tilt_min_deg: 50\n  floorless_tilt_max_deg: 40\n",
        ":3: key 'stair_detection.floorless_tilt_max_deg'",
        "stair_detection.floorless_tilt_min_deg must not exceed stair_detection.floorless_tilt_max_deg"},
@@ -353,8 +351,8 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
        "capture.min_range_m must be below capture.max_range_m"},
       {"floor:\n  height_min_m: 1.5\n  height_max_m: 1.2\n", ":3: key 'floor.height_max_m'",
        "floor.height_min_m must not exceed floor.height_max_m"},
-      {"manhattan:\n  riser_going_min_cm: 70\n", ":2: key 'manhattan.riser_going_min_cm'",
-       "manhattan.riser_going_min_cm must not exceed manhattan.riser_going_max_cm"},
+      {"stair_modelling:\n  blondel_min_cm: 80\n", ":2: key 'stair_modelling.blondel_min_cm'",
+       "stair_modelling.blondel_min_cm must not exceed stair_modelling.blondel_max_cm"},
   };
   int i = 0;
   for (const auto& c : cases) {
@@ -364,5 +362,5 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
     EXPECT_NE(e.find(c.what), std::string::npos) << e;
   }
   // Equal bounds stay allowed where they mean something (a single accepted value).
-  EXPECT_NO_THROW(load_config_text("floor:\n  curb_rise_min_cm: 10\n  curb_rise_max_cm: 10\n", "eq.yaml"));
+  EXPECT_NO_THROW(load_config_text("floor:\n  usual_height_min_m: 1.2\n  usual_height_max_m: 1.2\n", "eq.yaml"));
 }

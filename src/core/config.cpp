@@ -103,14 +103,6 @@ std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c) {
   order(c.floor.height_min, c.floor.height_max, "floor.height_min_m", "floor.height_max_m");
   order(c.floor.usual_tilt_min, c.floor.usual_tilt_max, "floor.usual_tilt_min_deg", "floor.usual_tilt_max_deg");
   order(c.floor.usual_height_min, c.floor.usual_height_max, "floor.usual_height_min_m", "floor.usual_height_max_m");
-  order(c.floor.search_start, c.floor.search_max, "floor.search_start_m", "floor.search_max_m");
-  order(c.floor.ambiguous_rise_min, c.floor.ambiguous_rise_max, "floor.ambiguous_rise_min_cm",
-        "floor.ambiguous_rise_max_cm");
-  order(c.floor.curb_rise_min, c.floor.curb_rise_max, "floor.curb_rise_min_cm", "floor.curb_rise_max_cm");
-  order(c.manhattan.riser_min_height, c.manhattan.riser_max_height, "manhattan.riser_min_height_cm",
-        "manhattan.riser_max_height_cm");
-  order(c.manhattan.riser_going_min, c.manhattan.riser_going_max, "manhattan.riser_going_min_cm",
-        "manhattan.riser_going_max_cm");
   order(c.classification.step_height_min, c.classification.step_height_max,
         "classification.step_height_min_cm", "classification.step_height_max_cm");
   order(c.stair_detection.floorless_tilt_min, c.stair_detection.floorless_tilt_max,

@@ -7,6 +7,11 @@
 /// fields once in `visit()`: the loader, the YAML writer and the equality test all walk that list,
 /// so a field cannot be known to one and forgotten by another.
 ///
+/// Only what a technician may need to set is a key (a physical quantity of the rig, the sensor,
+/// the stairs or the feedback). A field that `visit()` does not list is one of the method's own
+/// thresholds (which plane is a tread, which wall makes the Manhattan frame...): named here with its
+/// unit, fixed, and refused in a file like any unknown key (issue 39: 231 keys became 137).
+///
 /// A visitor `V` provides:
 ///   v.num(field, "key", Unit, min, max, "comment")  - float/double/int, range in file units
 ///   v.flag(field, "key", "comment")                 - bool
@@ -90,30 +95,8 @@ struct SegmentationConfig {
           "a region is planar when this share of it lies on its RANSAC plane");
     v.num(cluster_tolerance, "cluster_tolerance_cm", Unit::kCentimetre, 0.5, 100, "Euclidean clustering distance");
     v.num(cluster_min_points, "cluster_min_points", Unit::kCount, 1, 100000, "smallest obstacle cluster");
-    v.num(cell_size_px, "cell_size_px", Unit::kPixel, 3, 64, "cell edge for the cell plane fits seeding region growing");
-    v.num(fine_cell_size_px, "fine_cell_size_px", Unit::kPixel, 2, 64,
-          "cell edge of the second seeding pass (thin or far treads)");
     v.num(depth_noise_coeff, "depth_noise_coeff_per_m", Unit::kPerMetre, 1e-5, 0.1,
           "depth noise sigma = coeff * z^2 (Kinect: 1.425e-3)");
-    v.num(inlier_sigmas, "inlier_sigmas", Unit::kNone, 0.5, 20, "plane inlier test in depth-noise sigmas");
-    v.num(inlier_min_distance, "inlier_min_distance_mm", Unit::kMillimetre, 0, 100,
-          "added to the metric distance tests when merging regions");
-    v.num(region_min_pixels, "region_min_pixels", Unit::kPixel, 10, 1000000, "smallest planar region, pixels");
-    v.num(cluster_min_pixels, "cluster_min_pixels", Unit::kPixel, 10, 1000000, "smallest obstacle cluster, pixels");
-    v.num(points_stride_px, "points_stride_px", Unit::kPixel, 1, 16,
-          "region point lists keep every Nth pixel in both directions");
-    v.num(dominant_min_fraction, "dominant_min_percent", Unit::kPercent, 0.01, 50,
-          "share of the valid pixels a region needs for its normal to be a dominant direction");
-    v.num(strip_length_px, "strip_length_px", Unit::kPixel, 0, 64,
-          "columns of the 2-row windows that seed thin strips (far treads) on a dominant direction; 0 = off");
-    v.num(curved_tile_max_area, "curved_tile_max_area_m2", Unit::kNone, 0, 10,
-          "m^2: a region smaller than this, not parallel to a dominant direction, that bends smoothly into other regions "
-          "is a facet of a curved surface (a person, a bag) and goes to the obstacles; 0 = off");
-    v.num(curved_bend_max_angle, "curved_bend_max_angle_deg", Unit::kDegree, 1, 89,
-          "largest angle between two regions meeting without a depth jump that counts as a bend of one curved surface");
-    v.num(curved_facet_size_ratio, "curved_facet_size_ratio", Unit::kNone, 0, 1000,
-          "facets of one curved surface are of a size: a region bends into a neighbour as a facet only when it is at most "
-          "this many times the neighbour's area (a flat riser meeting a small noisy patch is no facet); 0 = any size");
   }
 };
 
@@ -199,65 +182,17 @@ struct FloorConfig {
           "frames in which a fresh start would find a clear floor at one other height, with none at the held one, "
           "that relearn the camera height (the wearer sat down, the rig was remounted); a lower floor needs no level "
           "in view between it and the camera");
-    v.num(search_start, "search_start_m", Unit::kMetre, 0.2, 10, "first forward window searched for floor");
-    v.num(search_step, "search_step_m", Unit::kMetre, 0.05, 10, "window growth per attempt");
-    v.num(search_max, "search_max_m", Unit::kMetre, 0.2, 20, "largest forward window");
     v.num(inlier_distance, "inlier_distance_cm", Unit::kCentimetre, 0.2, 20, "plane inlier distance (paper: voxel edge)");
     v.num(min_area, "min_area_m2", Unit::kNone, 0.01, 100, "smallest floor patch, square metres");
     v.num(track_max_height_jump, "track_max_height_jump_cm", Unit::kCentimetre, 0.5, 100,
           "camera height change accepted from one frame to the next");
     v.num(track_max_angle_jump, "track_max_angle_jump_deg", Unit::kDegree, 0.5, 90,
           "floor normal change accepted from one frame to the next");
-    v.num(horizontal_tolerance, "horizontal_tolerance_deg", Unit::kDegree, 0.5, 45,
-          "a plane parallel to the floor within this is a second floor candidate (never taken when nearer the camera)");
     v.num(track_hold_frames, "track_hold_frames", Unit::kCount, 0, 1000,
           "frames the tracked floor is held after it was last seen (no other level taken meanwhile)");
     v.num(track_forget_frames, "track_forget_frames", Unit::kCount, 0, 100000,
           "frames the camera height above the floor is remembered after the floor was last seen: meanwhile a "
           "plane a riser or more lower (a tread below the user) is never taken for the floor");
-    v.num(track_anchor_tolerance, "track_anchor_tolerance_cm", Unit::kCentimetre, 0, 20,
-          "a tracked floor within this of the camera height last verified from a clear view is kept even when "
-          "lower planes lie nearer the user (the user at the top of a descending staircase); 0 turns it off");
-    v.num(verify_drop, "verify_drop_cm", Unit::kCentimetre, 1, 100,
-          "floor check: a point this far below a candidate counts as below it");
-    v.num(verify_margin_angle, "verify_margin_deg", Unit::kDegree, 0, 30,
-          "floor check: points this much nearer the nadir than the candidate's near edge count as nearer the user");
-    v.num(view_edge_angle, "view_edge_deg", Unit::kDegree, 0, 30,
-          "a plane within this of the view's bottom edge starts at the edge (its start is not seen)");
-    v.num(ambiguous_rise_min, "ambiguous_rise_min_cm", Unit::kCentimetre, 1, 100,
-          "a candidate starting at the view's edge with a plane this much (min) above it ...");
-    v.num(ambiguous_rise_max, "ambiguous_rise_max_cm", Unit::kCentimetre, 1, 100, "... and at most this ...");
-    v.num(ambiguous_depth_max, "ambiguous_depth_max_cm", Unit::kCentimetre, 1, 500,
-          "... starting within this of its near edge may be a tread: not taken as the floor");
-    v.num(ambiguous_covered, "ambiguous_covered_percent", Unit::kPercent, 0, 100,
-          "... when this share of its pixels has the upper plane above them in the image");
-    v.num(ambiguous_tread_area_max, "ambiguous_tread_area_max_m2", Unit::kNone, 0.1, 100,
-          "... unless that plane is bigger than this, square metres (no tread or landing is: another floor level)");
-    v.num(floor_beyond_riser, "floor_beyond_riser_cm", Unit::kCentimetre, 0, 200,
-          "such a candidate whose level goes on this far beyond the riser line of the plane above, beside the flight ...");
-    v.num(floor_beyond_min_area, "floor_beyond_min_area_m2", Unit::kNone, 0.001, 10,
-          "... over this much area (square metres) is the floor around the flight, not its first tread");
-    v.num(floor_deeper_than_tread, "floor_deeper_than_tread_cm", Unit::kCentimetre, 0, 100,
-          "such a candidate deeper in front of the flight than its treads by this is no tread of it");
-    v.num(tread_depth_agreement, "tread_depth_agreement_cm", Unit::kCentimetre, 0, 20,
-          "the two treads ahead measured for that must agree in depth within this");
-    v.num(tread_min_aspect, "tread_min_aspect", Unit::kNone, 1, 20,
-          "a level counts as a tread (its short axis the flight's direction) when this many times wider than deep");
-    v.num(curb_rise_min, "curb_rise_min_cm", Unit::kCentimetre, 0, 100,
-          "cold view: a level this much or more above the floor candidate, cut by the view's bottom edge, with the "
-          "user's nadir on its side of its straight boundary with the candidate: the user may stand on it (no floor)");
-    v.num(curb_rise_max, "curb_rise_max_cm", Unit::kCentimetre, 0, 100, "... and at most this much above it");
-    v.num(curb_boundary_gap, "curb_boundary_gap_cm", Unit::kCentimetre, 1, 100,
-          "points of that level this near the candidate (in the floor plane) form their boundary");
-    v.num(curb_min_edge, "curb_min_edge_m", Unit::kMetre, 0, 10,
-          "that boundary is a curb's edge (not the corner of a platform or a crate) when at least this long");
-    v.num(curb_min_edge_cut, "curb_min_edge_cut_m", Unit::kMetre, 0, 10,
-          "... or at least this long when the view's border cuts it at both ends (its length unknown)");
-    v.num(curb_straightness, "curb_straightness_cm", Unit::kCentimetre, 0.1, 50,
-          "that boundary is a straight edge (a curb) when its rms off a line is at most this");
-    v.num(verify_min_pixels, "verify_min_pixels", Unit::kPixel, 1, 1000000,
-          "floor check: this many pixels below a candidate and nearer the user reject it (a step or seat seen from in front)");
-    v.num(verify_stride_px, "verify_stride_px", Unit::kPixel, 1, 32, "floor check: sampling grid of the frame");
   }
 };
 
@@ -311,116 +246,6 @@ struct ManhattanConfig {
     v.num(vertical_tolerance, "vertical_tolerance_deg", Unit::kDegree, 0.5, 45,
           "a plane is vertical within this angle");
     v.num(min_area, "min_area_m2", Unit::kNone, 0, 100, "vertical plane area needed for a Manhattan frame, square metres");
-    v.num(cluster_tolerance, "cluster_tolerance_deg", Unit::kDegree, 0.5, 44,
-          "vertical normals within this of the dominant direction (mod 90 deg) refine it");
-    v.num(yaw_full_width, "yaw_full_width_cm", Unit::kCentimetre, 1, 1000,
-          "a vertical plane's vote weighs area * min(1, horizontal width / this)^2: a narrow plane's yaw is imprecise");
-    v.num(min_plane_width, "min_plane_width_cm", Unit::kCentimetre, 0, 1000,
-          "an agreeing vertical plane this wide (a wall, a riser) makes the frame trusted; people and posts are narrower");
-    v.num(max_spread, "max_spread_deg", Unit::kDegree, 0.1, 45,
-          "without such a plane, the agreeing planes (weighted) may spread this much at most");
-    v.num(floor_beyond_margin, "floor_beyond_margin_cm", Unit::kCentimetre, 0, 500,
-          "floor farther than this beyond a vertical plane's extension marks it as standing inside the room");
-    v.num(floor_beyond_area, "floor_beyond_area_m2", Unit::kNone, 0, 100,
-          "square metres of floor beyond a vertical plane that make it furniture or a riser, not a wall "
-          "(such planes vote only when the walls alone make no frame)");
-    v.num(floor_beyond_height, "floor_beyond_height_cm", Unit::kCentimetre, 0.5, 50,
-          "horizontal planes within this of the floor count as floor for the test above");
-    v.num(min_bounding_width, "min_bounding_width_cm", Unit::kCentimetre, 0, 1000,
-          "min_plane_width for vertical planes standing on the floor with no floor beyond them (walls); "
-          "as narrow as a wall that may veto a frame (veto_min_width)");
-    v.num(range_clip_margin, "range_clip_margin_cm", Unit::kCentimetre, 0, 200,
-          "a vertical plane with most of its points this near the depth cut-off (capture max_range) cannot make a "
-          "frame of walls alone: its fit may be biased");
-    v.num(far_wall_range, "far_wall_range_cm", Unit::kCentimetre, 0, 1000,
-          "a wall (a vertical plane on the floor, nothing beyond it) whose centroid is this far from the camera ...");
-    v.num(far_wall_width, "far_wall_width_cm", Unit::kCentimetre, 0, 1000,
-          "... and narrower than this has a yaw good to a few degrees only: the real sensor's depth noise there is "
-          "centimetres, correlated between neighbouring pixels ...");
-    v.num(far_wall_agreement, "far_wall_agreement_deg", Unit::kDegree, 0, 45,
-          "... so when such walls alone make the frame and all the vertical planes together (risers, furniture: "
-          "nearer, wider) make one within this of it, that one is taken; 0: never");
-    v.num(riser_max_height, "riser_max_height_cm", Unit::kCentimetre, 0, 100,
-          "a vertical plane at most this tall with a tread on its top edge (a horizontal plane starting there and "
-          "going on beyond it) may be a riser, or an open riser's tread front ...");
-    v.num(riser_tread_tolerance, "riser_tread_tolerance_cm", Unit::kCentimetre, 0, 20,
-          "... the tread within this of its top edge's height ...");
-    v.num(riser_min_height, "riser_min_height_cm", Unit::kCentimetre, 0, 100,
-          "... and two such planes whose treads lie at least this much apart in height (at most riser_max_height_cm) "
-          "...");
-    v.num(riser_going_min, "riser_going_min_cm", Unit::kCentimetre, 0, 200,
-          "... the one at least this far beyond the other ...");
-    v.num(riser_going_max, "riser_going_max_cm", Unit::kCentimetre, 0, 200,
-          "... and at most this, are a flight's risers; one standing on the floor alone, at least riser_min_height_cm "
-          "tall ...");
-    v.num(single_riser_min_width, "single_riser_min_width_cm", Unit::kCentimetre, 0, 1000,
-          "... is a riser (a single step, a curb) when this wide ...");
-    v.num(single_riser_min_depth, "single_riser_min_depth_cm", Unit::kCentimetre, 0, 1000,
-          "... and its tread is seen to go on this far beyond it (a shelf's plinth and bottom board: 30-45 cm)");
-    v.num(riser_agreement, "riser_agreement_deg", Unit::kDegree, 0, 45,
-          "the risers' frame is the staircase's own: where only walls far_wall_range_cm away or at the depth cut-off "
-          "make the walls' frame, the risers' frame within this of it is taken, and such walls cannot veto a frame "
-          "that risers agree with; 0: risers have no such standing");
-    v.num(hanging_min_height, "hanging_min_height_cm", Unit::kCentimetre, 0, 300,
-          "a vertical plane with floor beyond it (not a riser) whose lowest point is this high above the floor hangs "
-          "there as furniture or people do (a seat's apron, a chair's back, a table's edge): it votes, but makes no "
-          "frame alone, nor with another such plane; 0 = off");
-    v.num(structure_beyond_area, "structure_beyond_area_m2", Unit::kNone, 0, 100,
-          "square metres of other surfaces (a wall, a worktop, a seat, treads) beyond a vertical plane's extension that "
-          "make it no wall; a wall (nothing beyond it, on the floor or at the depth cut-off) with this much of it beyond "
-          "a plane that makes the frame, and disagreeing with the frame modulo 90 deg, vetoes the frame: no frame, or "
-          "the frame of the walls agreeing with it when the widest such wall is min_plane_width wide");
-    v.num(veto_min_width, "veto_min_width_cm", Unit::kCentimetre, 0, 1000,
-          "narrowest wall that may veto a frame as above: a narrower plane's yaw is off by degrees");
-    v.num(sliver_width, "sliver_width_cm", Unit::kCentimetre, 0, 200,
-          "a vertical plane seen mostly at the depth cut-off and narrower than this in its narrowest in-plane "
-          "direction is a sliver whose yaw may be off by up to 10 deg");
-    v.num(clipped_disagreement, "clipped_disagreement_deg", Unit::kDegree, 0.5, 45,
-          "a sliver contradicts another direction, modulo 90 deg, only when it differs by more than this (other "
-          "planes: cluster_tolerance)");
-    v.num(band_max_thickness, "band_max_thickness_cm", Unit::kCentimetre, 0, 100,
-          "a vertical plane thinner than this on average (area / length) is a band that fixes its plane only up to a "
-          "turn about its long axis ...");
-    v.num(band_min_slope, "band_min_slope_deg", Unit::kDegree, 0, 90,
-          "... which turns its yaw when that axis slopes more than this (a handrail or a stringer along a flight): "
-          "such a band votes but cannot make the frame, alone or in a pair");
-    v.num(level_band_max_height, "level_band_max_height_cm", Unit::kCentimetre, 0, 100,
-          "a plane narrower than this (its bounding rectangle's short side) is a band that fixes its plane only up to "
-          "a turn about its long axis ...");
-    v.num(level_band_max_tilt, "level_band_max_tilt_deg", Unit::kDegree, 0, 90,
-          "... so along a level axis its tilt may be off, its yaw is not: tilted up to this from vertical ...");
-    v.num(level_band_max_slope, "level_band_max_slope_deg", Unit::kDegree, 0, 45,
-          "... with its axis sloping less than this, it joins the vertical planes that the image edges confirm "
-          "(compass_*), its heading taken from its axis; it makes no frame otherwise");
-    v.num(pair_min_width, "pair_min_width_cm", Unit::kCentimetre, 0, 1000,
-          "without a wide vertical plane, two agreeing parallel planes each at least this wide (in the walls' frame: "
-          "not at the depth cut-off) may make the frame trusted; narrower ones (a person's legs, an arm) have no yaw worth the name");
-    v.num(pair_tolerance, "pair_tolerance_deg", Unit::kDegree, 0.1, 45,
-          "such two planes agree within this (their headings modulo 180 deg; coplanar ones also the line between them)");
-    v.num(pair_min_separation, "pair_min_separation_cm", Unit::kCentimetre, 0, 1000,
-          "such two planes are distinct (a flight's risers, a wall and a riser) when this far apart along their normal; "
-          "nearer, only as strips of one plane on one line (within pair_tolerance), as wide as they span together");
-    v.num(compass_min_support, "compass_min_support", Unit::kNone, 0, 1,
-          "when the vertical planes alone make no trusted frame, the image edges' dominant horizontal direction "
-          "(given the floor's vertical) is asked; it counts when this share of the edges' votes lies at its peak "
-          "(a uniform spread gives 0.04); 1: never ask");
-    v.num(compass_agreement, "compass_agreement_deg", Unit::kDegree, 0.1, 45,
-          "vertical planes within this of that direction (modulo 90 deg) ...");
-    v.num(compass_min_width, "compass_min_width_cm", Unit::kCentimetre, 0, 1000,
-          "... make the frame when one of them is this wide, although too narrow or too small to be trusted alone");
-    v.num(compass_wall_min_support, "compass_wall_min_support", Unit::kNone, 0, 1,
-          "edges with less support than compass_min_support, down to this, confirm only a wall strip (on the floor, "
-          "nothing seen beyond it, clear of the depth cut-off and near) too small to make the frame alone; 1: never");
-    v.num(compass_veto_min_support, "compass_veto_min_support", Unit::kNone, 0, 1,
-          "where walls too narrow to make a frame veto the furniture's (structure_beyond_area), the image edges' "
-          "direction with this share of their votes at its peak gives the frame ...; 1: never");
-    v.num(compass_veto_agreement, "compass_veto_agreement_deg", Unit::kDegree, 0, 45,
-          "... when it agrees within this with the widest vetoing wall (modulo 90 deg) and not with the furniture's "
-          "frame; 0: never");
-    v.num(compass_line_min_length, "compass_line_min_length_px", Unit::kPixel, 0, 10000,
-          "where the edges' dominant direction confirms no plane, a straight edge lying on the floor (a wall's foot, "
-          "even beyond the depth cut-off; a floor joint) this long gives the frame its direction when a wall, "
-          "compass_min_width wide, agrees with it within compass_agreement; 0: never");
     v.flag(without_floor, "without_floor",
            "with no floor found, measure the frame about the vertical of a floor-like plane the floor's checks refused "
            "(a tread, a seat: which level the user stands on is in doubt, which way is up is not)");
@@ -475,8 +300,6 @@ struct StairDetectionConfig {
     v.num(connection_min_points, "connection_min_points", Unit::kCount, 1, 100000, "points within the radius to connect");
     v.num(height_tolerance, "height_tolerance_cm", Unit::kCentimetre, 0, 10,
           "measurement slack on the H_min..H_max range between levels");
-    v.num(connection_max_points, "connection_max_points", Unit::kCount, 16, 100000,
-          "points per region used in the connection test (evenly subsampled)");
     v.num(curb_height_min, "curb_height_min_cm", Unit::kCentimetre, 1, 100,
           "lowest curb: a single level this far above or below the floor may be a curb");
     v.num(single_min_width, "single_min_width_m", Unit::kMetre, 0.05, 10,
@@ -529,16 +352,10 @@ struct StairModellingConfig {
     v.num(blondel_min, "blondel_min_cm", Unit::kCentimetre, 10, 300, "building code described: lowest 2R+T");
     v.num(blondel_max, "blondel_max_cm", Unit::kCentimetre, 10, 300, "building code described: highest 2R+T");
     v.num(width_min, "width_min_cm", Unit::kCentimetre, 5, 1000, "building code described: narrowest staircase (what cannot be walked is fixed: rise 5-25 cm, tread >= 15 cm, width >= 50 cm)");
-    v.num(manhattan_min_fraction, "manhattan_min_percent", Unit::kPercent, 0, 100,
-          "share of Manhattan points needed to take the stair axes from the Manhattan frame");
-    v.num(manhattan_max_disagreement, "manhattan_max_disagreement_deg", Unit::kDegree, 0, 45,
-          "Manhattan axes are used only when within this of the steps' own (PCA) axes");
     v.num(dimension_tolerance, "dimension_tolerance_cm", Unit::kCentimetre, 0, 10,
           "measurement slack on the building-code limits");
     v.num(edge_max_residual, "edge_max_residual_cm", Unit::kCentimetre, 0.5, 50,
           "largest deviation of a step edge from evenly spaced edges");
-    v.num(tread_tolerance_per_m2, "tread_tolerance_cm_per_m2", Unit::kCentimetre, 0, 10,
-          "extra slack on the tread and 2R+T limits per square metre of distance to the first edge");
   }
 };
 
@@ -586,21 +403,7 @@ struct TraversalConfig {
           "a tread this many goings deep is the last one (a landing or the floor beyond)");
     v.num(correction_gain, "correction_gain_percent", Unit::kPercent, 0, 100,
           "share of the live view's residual (height, along, yaw, vertical) applied each frame, times its quality");
-    v.num(tilt_gain, "tilt_gain_percent", Unit::kPercent, 0, 100,
-          "share of the correction gain applied to the vertical (the odometry's tilt drifts little; a view's vertical is noisy)");
     v.flag(correct, "correct", "correct the odometry-held stair pose from the live view (paper eq. 15)");
-    v.num(match_fraction, "match_percent", Unit::kPercent, 5, 50,
-          "a seen level matches a step of the model within this share of the riser (height) and tread (edge)");
-    v.num(max_yaw_disagreement, "max_yaw_disagreement_deg", Unit::kDegree, 1, 90,
-          "a detection whose axes differ more than this from the held staircase's is another staircase");
-    v.num(max_riser_disagreement, "max_riser_disagreement_cm", Unit::kCentimetre, 0.1, 10,
-          "a view whose riser differs more than this from the fused riser does not correct the staircase");
-    v.num(max_tread_disagreement, "max_tread_disagreement_cm", Unit::kCentimetre, 0.1, 20,
-          "a view whose tread differs more than this from the fused tread does not correct the staircase");
-    v.num(max_tilt_disagreement, "max_tilt_disagreement_deg", Unit::kDegree, 0.1, 45,
-          "a view whose vertical differs more than this from the held staircase's does not correct it");
-    v.num(near_levels, "near_levels", Unit::kCount, 1, 50,
-          "the levels nearest the user whose height and edge residuals (their median) correct the held pose");
     v.num(arrive_margin, "arrive_margin_cm", Unit::kCentimetre, 0, 200,
           "the user has arrived this far past the last step edge");
     v.num(arrive_hold, "arrive_hold_s", Unit::kSecond, 0, 60, "the arrival is reported this long, then searching again");
@@ -638,14 +441,6 @@ struct OdometryConfig {
     v.num(min_valid_fraction, "min_valid_percent", Unit::kPercent, 0.1, 100, "pixels with depth needed to track");
     v.num(max_translation, "max_translation_cm", Unit::kCentimetre, 1, 500, "motion per frame beyond walking = failure");
     v.num(max_rotation, "max_rotation_deg", Unit::kDegree, 1, 180, "rotation per frame beyond walking = failure");
-    v.num(max_points_per_level, "max_points_per_level", Unit::kCount, 500, 10000000,
-          "pixels used per pyramid level; a level with more is subsampled on a regular grid");
-    v.num(max_inv_depth_step, "max_inv_depth_step_percent", Unit::kPercent, 0.5, 100,
-          "inverse-depth change between neighbouring full-resolution pixels treated as a depth edge");
-    v.num(min_update_translation, "min_update_translation_mm", Unit::kMillimetre, 0.001, 100,
-          "a level stops when its update moves less than this and turns less than min_update_rotation");
-    v.num(min_update_rotation, "min_update_rotation_deg", Unit::kDegree, 0.0001, 10,
-          "a level stops when its update turns less than this and moves less than min_update_translation");
     v.num(min_inlier_fraction, "min_inlier_percent", Unit::kPercent, 0, 100,
           "share of used pixels whose residuals are within 3 sigma, below which the estimate is a failure");
     v.flag(adaptive_scale, "adaptive_scale",
@@ -654,8 +449,6 @@ struct OdometryConfig {
           "track against one reference (keyframe) until the camera is this far from it; 0 = frame to frame");
     v.num(keyframe_max_rotation, "keyframe_max_rotation_deg", Unit::kDegree, 0, 90,
           "track against one reference (keyframe) until the camera has turned this much from it");
-    v.num(keyframe_min_overlap, "keyframe_min_overlap_percent", Unit::kPercent, 0, 100,
-          "share of the reference's points still matched in the current frame below which it is replaced");
   }
 };
 
