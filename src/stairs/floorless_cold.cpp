@@ -24,6 +24,13 @@ void FloorlessStairs::run_cold(const SceneResult& scene, const CameraIntrinsics*
   // places the steps from the feet as a remembered height would. Without it, the checks below
   // settle whether the first seen level is the floor; otherwise its step number is unknown and the
   // stack is reported without_floor or refused.
+  // Split at the landing the user stands on, the flight's first level is that landing: the other
+  // flight's levels, a riser or more from it, are no floor of the user's.
+  if (trace_.landing_split) {
+    model(scene, K, dir, 0, level0, out);
+    if (!model_on_floor_level(scene, K, dir, out)) model(scene, K, dir, 0, level0, out);
+    return;
+  }
   const float seen = seen_floor_height(dir, riser);
   if (seen > 0.f) {
     trace_.floor_seen = true;

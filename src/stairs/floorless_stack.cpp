@@ -248,7 +248,43 @@ FloorlessStairs::StackDirection FloorlessStairs::stack_direction() {
       dir = -1;
     }
   }
+  // Still none: the user may stand on a landing between two flights.
+  if (dir == 0) {
+    dir = split_at_landing();
+    n = static_cast<int>(chain_.size());
+  }
   return {dir, n};
+}
+
+int FloorlessStairs::split_at_landing() {
+  // On a landing, seen from it: a flight goes on up from it and another goes down from it (an L or
+  // U staircase, the user at the turn). Stacked together the levels rise away from the user above
+  // the landing and fall away below it, so no one direction holds. The level the user stands on
+  // comes nearest (cut by the view's bottom border), every level above it lies farther the higher
+  // it is, every level below it farther the lower it is: two flights from the user's level. The
+  // one with more levels seen is told (a tie: the one going down, the fall), the landing as its
+  // first level, where the cold start asks whether it is the floor (it is, when deeper than a tread).
+  const int n = static_cast<int>(chain_.size());
+  const std::vector<float> d = trace_.near_distances;  // a copy: trimmed below
+  if (n < 3 || static_cast<int>(d.size()) != n) return 0;
+  const int u = static_cast<int>(std::min_element(d.begin(), d.end()) - d.begin());
+  if (u == 0 || u == n - 1) return 0;
+  // A flight leading off to the side of the landing (the lower one of a U, seen past the turn)
+  // need not fall away in the view's depth: only a branch that does counts as a flight ahead.
+  bool up_ok = true, down_ok = true;
+  for (int k = u + 1; k < n; ++k) up_ok = up_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k - 1)] + kMinRise;
+  for (int k = u - 1; k >= 0; --k) down_ok = down_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k + 1)] + kMinRise;
+  if (!up_ok && !down_ok) return 0;
+  const int up_levels = n - u, down_levels = u + 1;
+  const bool up = up_ok && (!down_ok || up_levels > down_levels);
+  const std::size_t first = up ? static_cast<std::size_t>(u) : 0, last = up ? chain_.size() : static_cast<std::size_t>(u) + 1;
+  chain_.assign(chain_.begin() + static_cast<long>(first), chain_.begin() + static_cast<long>(last));
+  const std::vector<float> heights = trace_.level_heights;
+  trace_.level_heights.assign(heights.begin() + static_cast<long>(first), heights.begin() + static_cast<long>(last));
+  trace_.near_distances.assign(d.begin() + static_cast<long>(first), d.begin() + static_cast<long>(last));
+  trace_.stacked = static_cast<int>(chain_.size());
+  trace_.landing_split = true;
+  return up ? 1 : -1;
 }
 
 FloorlessStairs::StackFit FloorlessStairs::fit_stack_heights(int dir, int n) {

@@ -113,6 +113,7 @@ struct FloorlessTrace {
   /// The stack's top level was the floor around a stairwell (farther than the first tread below it,
   /// a chest camera's height below the camera): taken out of the stack, descending (see the file comment).
   bool floor_beside = false;
+  bool landing_split = false;  ///< the stack was split at the landing the user stands on (split_at_landing)
   /// Cold, two levels going down with an upright face between their heights (a riser facing the
   /// user): the direction is contradicted and nothing is reported.
   bool riser_against = false;
@@ -155,6 +156,9 @@ class FloorlessStairs {
   };
 
   /// The stack's direction and size after the direction phase.
+  /// With no one direction: the stack split at the landing the user stands on (the nearest level,
+  /// flights rising and falling away from it); the kept flight's direction, 0 when it is no landing.
+  int split_at_landing();
   struct StackDirection {
     int dir = 0;  ///< +1 ascending, -1 descending, 0 undecided (no staircase)
     int n = 0;    ///< stacked levels (the floor beside a stairwell taken out)

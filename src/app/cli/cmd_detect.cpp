@@ -134,6 +134,7 @@ int detect(Context& ctx) {
                           (t.first_near_cut ? "true" : "false") + ", \"first_depth_m\": " + fmt(t.first_depth) + ", \"floor_level\": " +
                           (t.floor_level ? "true" : "false") + ", \"floor_seen\": " + (t.floor_seen ? "true" : "false") +
                           ", \"floor_beside\": " + (t.floor_beside ? "true" : "false") +
+                          ", \"landing_split\": " + (t.landing_split ? "true" : "false") +
                           ", \"riser_against\": " + (t.riser_against ? "true" : "false") +
                           ", \"anchored\": " + (t.anchored ? "true" : "false") + ", \"first_index\": " +
                           fmt(t.first_index) + "}");
