@@ -6,9 +6,11 @@
 //
 // StandingWearer.FloorAndStairsWithinASecond runs a grid small enough for CI (seed 4301, never
 // tuned on). DISABLED_Measure is the issue's figure: SG_STANDING_SEEDS (default "4301 4302"),
-// SG_STANDING_VIEWS (default 3) views per flight preset, on every rig of the grid below.
+// SG_STANDING_VIEWS (default 3) views per flight preset, on every rig of the grid below;
+// SG_STANDING_JSON=FILE also writes the figure as JSON (tools/figures does).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -69,14 +71,43 @@ PairOutcome stand(const PipelineConfig& cfg, const std::string& preset, long vie
 
 struct Tally {
   int pairs = 0, told = 0;
+  std::vector<int> first_frames;   ///< of the pairs told
+  std::vector<std::string> misses;  ///< what was missed, and the last frame's state
   void add(const PairOutcome& o, const char* what) {
     if (!o.in_view) return;
     ++pairs;
     const bool good = o.first_frame >= 0 && o.held;
     told += good;
-    if (!good) std::printf("standing: MISSED %s: first %d, last frame %s\n", what, o.first_frame, o.last.c_str());
+    if (good) first_frames.push_back(o.first_frame);
+    if (good) return;
+    misses.push_back(std::string(what) + ": first " + std::to_string(o.first_frame) + ", last frame " + o.last);
+    std::printf("standing: MISSED %s\n", misses.back().c_str());
   }
 };
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+/// The figure as JSON (tools/figures stores it in docs/figures/standing-wearer.json).
+void write_json(const Tally& t, const char* path) {
+  std::vector<int> f = t.first_frames;
+  std::sort(f.begin(), f.end());
+  std::FILE* out = std::fopen(path, "w");
+  ASSERT_NE(out, nullptr) << "cannot write " << path;
+  std::fprintf(out, "{\"pairs\": %d, \"told\": %d, \"told_share\": %.4f, \"frames\": %ld, ", t.pairs, t.told,
+               t.pairs ? static_cast<double>(t.told) / t.pairs : 0.0, kFrames);
+  std::fprintf(out, "\"first_frame_median\": %d, \"first_frame_max\": %d, \"misses\": [",
+               f.empty() ? -1 : f[f.size() / 2], f.empty() ? -1 : f.back());
+  for (std::size_t i = 0; i < t.misses.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_string(t.misses[i]).c_str());
+  std::fprintf(out, "]}\n");
+  std::fclose(out);
+}
 
 void run_grid(Tally& t, const std::vector<Rig>& rigs, const std::vector<std::uint32_t>& seeds, long views) {
   const PipelineConfig cfg;
@@ -122,6 +153,7 @@ TEST(StandingWearer, DISABLED_Measure) {
   run_grid(t, rigs, env_seeds("SG_STANDING_SEEDS", {4301u, 4302u}), v ? std::atol(v) : 3);
   std::printf("standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames (%.1f%%)\n",
               t.told, t.pairs, kFrames, t.pairs ? 100.0 * t.told / t.pairs : 0.0);
+  if (const char* path = std::getenv("SG_STANDING_JSON")) write_json(t, path);
 }
 
 }  // namespace

@@ -69,6 +69,23 @@ FIGURES = [
       ("recall", "recall, every view with a staircase", "", "ratio"),
       ("riser_err_mean_m", "riser error, mean", "<= 1 cm", "m->cm"),
       ("tread_err_mean_m", "tread error, mean", "<= 1 cm", "m->cm")]),
+    ("eval-world2", "Stair detection, the second world (issue 39's structures)",
+     "stairguide eval on 24 views each of the second world's presets, seed 801 (never tuned on), "
+     "Kinect v1 artefacts: flights rising beside a landing (turn), low risers, steep goings, carpet "
+     "and things on the steps (dressed), the wearer's legs in view, waist cameras (lowrig); and six "
+     "stair-free scenes (shelves, boxes, sofa, bench, low table, bed). Per preset in by_scene.",
+     [("fp", "false positives and misplaced detections", "0", ""),
+      ("recall_fully_visible", "recall, >= 2 steps fully visible", ">= 99%", "ratio"),
+      ("recall", "recall, every view with a staircase", "", "ratio"),
+      ("riser_err_mean_m", "riser error, mean", "<= 1 cm", "m->cm"),
+      ("tread_err_mean_m", "tread error, mean", "<= 1 cm", "m->cm")]),
+    ("standing-wearer", "A wearer standing still at a staircase, any rig",
+     "tools/standing-wearer: rigs 0.5-1.8 m x 15-80 deg (20), the world's flights up and down and "
+     "the waist-camera flights, seeds 4301-4302, 3 views each; the daemon's perception stage sees "
+     "one view 30 times through fresh noise, nothing learned before.",
+     [("told_share", "pairs with the floor and the flight, placed, within 30 frames", ">= 98%", "ratio"),
+      ("pairs", "(rig, flight) pairs with >= 2 steps in view", "", ""),
+      ("first_frame_max", "latest first frame among those told", "< 30", "")]),
     ("eval-real", "Stair detection, labelled real frames",
      "stairguide eval on ../shared/data/labels.csv: real Kinect clouds and frames labelled by hand "
      "(stairs and stair-free scenes).",
