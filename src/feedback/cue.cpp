@@ -48,6 +48,14 @@ const char* to_string(Cue c) {
       return "battery_critical";
     case Cue::kSlow:
       return "slow";
+    case Cue::kWhere:
+      return "where";
+    case Cue::kMuted:
+      return "muted";
+    case Cue::kUnmuted:
+      return "unmuted";
+    case Cue::kVerbosity:
+      return "verbosity";
   }
   return "?";
 }
@@ -85,6 +93,11 @@ int cue_priority(Cue c) {
       return 4;
     case Cue::kApproach:
     case Cue::kSlow:
+    // The answers to a press: the wearer asked, and waits for them.
+    case Cue::kWhere:
+    case Cue::kMuted:
+    case Cue::kUnmuted:
+    case Cue::kVerbosity:
       return 5;
     case Cue::kBatteryLow:
       return 3;
@@ -131,8 +144,19 @@ std::string token(const CueEvent& e) {
     }
     return s;
   }
-  if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning) {
+  if (e.cue == Cue::kWhere && e.kind == StairKind::kNone && e.clock == 0) {
+    if (e.number >= 0) return s + ":" + std::to_string(e.number) + "_left";  // on a flight
+    return s + "_none";
+  }
+  if (e.cue == Cue::kVerbosity) {
+    static const char* level[] = {"_quiet", "_normal", "_verbose"};
+    return s + level[std::clamp(e.number, 0, 2)];
+  }
+  if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning ||
+      e.cue == Cue::kWhere) {
     if (e.cue == Cue::kStepAhead) s = e.kind == StairKind::kCurb ? "curb" : "step";
+    if (e.cue == Cue::kWhere)
+      s += e.kind == StairKind::kCurb ? "_curb" : e.kind == StairKind::kSingleStep ? "_step" : "";
     s += e.direction > 0 ? "_up" : "_down";
     if (e.number >= 0) s += ":" + std::to_string(e.number) + "m";
     if (e.clock > 0) s += "@" + std::to_string(e.clock);
@@ -150,6 +174,39 @@ std::string tokens(const std::vector<CueEvent>& events) {
   }
   return s;
 }
+
+namespace {
+// The answer to "where are the stairs?": what is ahead with its distance and clock position (said
+// even at 12: the wearer asked where), the steps left on a flight, or "no stairs".
+std::vector<std::string> where_clips(const CueEvent& e) {
+  const bool up = e.direction > 0;
+  std::vector<std::string> c;
+  switch (e.kind) {
+    case StairKind::kAscending:
+    case StairKind::kDescending:
+      c = {up ? "stairs_up" : "stairs_down"};
+      break;
+    case StairKind::kSingleStep:
+      c = {up ? "step_up" : "step_down"};
+      break;
+    case StairKind::kCurb:
+      c = {up ? "curb_up" : "curb_down"};
+      break;
+    default:
+      if (sayable(e.number)) return {number_clip(e.number), "steps_left"};
+      return {"no_stairs"};
+  }
+  if (sayable(e.number)) {
+    c.push_back(number_clip(e.number));
+    c.push_back(e.number == 1 ? "metre" : "metres");
+  }
+  if (e.clock >= 1 && e.clock <= 12) {
+    c.push_back(number_clip(e.clock));
+    c.push_back("oclock");
+  }
+  return c;
+}
+}  // namespace
 
 std::vector<std::string> clips_for(const CueEvent& e) {
   std::vector<std::string> c;
@@ -230,6 +287,18 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kSlow:
       c = {"slow"};
       break;
+    case Cue::kWhere:
+      c = where_clips(e);
+      break;
+    case Cue::kMuted:
+      c = {"muted"};
+      break;
+    case Cue::kUnmuted:
+      c = {"unmuted"};
+      break;
+    case Cue::kVerbosity:
+      c = {e.number <= 0 ? "quiet" : e.number == 1 ? "normal" : "verbose"};
+      break;
   }
   return c;
 }
@@ -240,11 +309,16 @@ const std::vector<std::string>& all_clip_names() {
         "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
         "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
-        "approach", "battery_low", "battery_critical", "slow"};
+        "approach", "battery_low", "battery_critical", "slow",
+        "no_stairs", "muted", "unmuted", "quiet", "normal", "verbose"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();
   return names;
+}
+
+bool is_earcon_clip(const std::string& name) {
+  return name == "tick" || name == "approach" || name == "up" || name == "down" || name == "warning";
 }
 
 }  // namespace stairguide::feedback
