@@ -208,7 +208,46 @@ std::vector<std::string> where_clips(const CueEvent& e) {
 }
 }  // namespace
 
+namespace {
+// The clip of a cue said by one clip of its own whatever it carries; nullptr for the others.
+const char* own_clip(Cue c) {
+  switch (c) {
+    case Cue::kReady:
+      return "ready";
+    case Cue::kCameraLost:
+      return "camera_lost";
+    case Cue::kCameraBack:
+      return "camera_back";
+    case Cue::kBlind:
+      return "cannot_see";
+    case Cue::kFirstStep:
+      return "first_step";
+    case Cue::kTick:
+      return "tick";
+    case Cue::kLastStep:
+      return "last_step";
+    case Cue::kEndOfStairs:
+      return "end_of_stairs";
+    case Cue::kApproach:
+      return "approach";
+    case Cue::kBatteryLow:
+      return "battery_low";
+    case Cue::kBatteryCritical:
+      return "battery_critical";
+    case Cue::kSlow:
+      return "slow";
+    case Cue::kMuted:
+      return "muted";
+    case Cue::kUnmuted:
+      return "unmuted";
+    default:
+      return nullptr;
+  }
+}
+}  // namespace
+
 std::vector<std::string> clips_for(const CueEvent& e) {
+  if (const char* own = own_clip(e.cue)) return {own};
   std::vector<std::string> c;
   const bool up = e.direction > 0;
   auto distance = [&] {
@@ -222,18 +261,6 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     }
   };
   switch (e.cue) {
-    case Cue::kReady:
-      c = {"ready"};
-      break;
-    case Cue::kCameraLost:
-      c = {"camera_lost"};
-      break;
-    case Cue::kCameraBack:
-      c = {"camera_back"};
-      break;
-    case Cue::kBlind:
-      c = {"cannot_see"};
-      break;
     case Cue::kStairsAhead:
       if (e.earcon_only) {
         c = {up ? "up" : "down"};
@@ -254,12 +281,6 @@ std::vector<std::string> clips_for(const CueEvent& e) {
       else
         c = {up ? "step_up" : "step_down"};
       break;
-    case Cue::kFirstStep:
-      c = {"first_step"};
-      break;
-    case Cue::kTick:
-      c = {"tick"};
-      break;
     case Cue::kCount:
       if (sayable(e.number))
         c = {number_clip(e.number)};
@@ -269,35 +290,13 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kStepsLeft:
       if (sayable(e.number)) c = {number_clip(e.number), "steps_left"};
       break;
-    case Cue::kLastStep:
-      c = {"last_step"};
-      break;
-    case Cue::kEndOfStairs:
-      c = {"end_of_stairs"};
-      break;
-    case Cue::kApproach:
-      c = {"approach"};
-      break;
-    case Cue::kBatteryLow:
-      c = {"battery_low"};
-      break;
-    case Cue::kBatteryCritical:
-      c = {"battery_critical"};
-      break;
-    case Cue::kSlow:
-      c = {"slow"};
-      break;
     case Cue::kWhere:
       c = where_clips(e);
       break;
-    case Cue::kMuted:
-      c = {"muted"};
-      break;
-    case Cue::kUnmuted:
-      c = {"unmuted"};
-      break;
     case Cue::kVerbosity:
       c = {e.number <= 0 ? "quiet" : e.number == 1 ? "normal" : "verbose"};
+      break;
+    default:  // own_clip's
       break;
   }
   return c;
