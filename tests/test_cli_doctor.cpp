@@ -204,7 +204,8 @@ TEST(Doctor, AMissingCueAndAMissingUserAreNamed) {
   fs::remove_all(sounds);
   fs::create_directories(sounds);
   for (const auto& e : fs::directory_iterator(fs::path(STAIRGUIDE_SOURCE_DIR) / "sounds"))
-    if (e.path().filename() != "last_step.wav") fs::copy_file(e.path(), sounds / e.path().filename());
+    if (e.is_regular_file() && e.path().filename() != "last_step.wav")  // the English set, not es/, de/, ...
+      fs::copy_file(e.path(), sounds / e.path().filename());
   PipelineConfig c = null_sound_config();
   c.feedback.sounds_dir = sounds.string();
   const fs::path config = write_config("nocue", c);

@@ -438,16 +438,36 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
             "/usr/share/stairguide/sounds ('cmake --install' in PREFIX/share/stairguide/sounds)";
     return c;
   }
+  // The words of the configured language (feedback.language), the earcons from the folder itself.
+  const feedback::SoundSet set = feedback::sound_set_for(dir, cfg.language);
+  if (!set.problem.empty()) {
+    c.status = Status::kFail;
+    c.message = set.problem + ": the daemon speaks English instead";
+    c.fix = "set feedback.language to one of the folders under " + dir +
+            " (en: the folder itself), or make the set with tools/make-sounds --lang " + cfg.language;
+    return c;
+  }
   const auto& names = feedback::all_clip_names();
-  const feedback::SoundBank bank = feedback::load_sound_bank(dir, names, 1.0f);
-  std::vector<std::string> problems = bank.problems;
+  std::vector<std::pair<std::string, std::vector<std::string>>> folders;  // each folder, the clips it holds
+  if (set.speech_dir == set.earcon_dir) {
+    folders.push_back({dir, names});
+  } else {
+    folders.push_back({set.speech_dir, {}});
+    folders.push_back({set.earcon_dir, {}});
+    for (const auto& n : names) folders[feedback::is_earcon_clip(n) ? 1 : 0].second.push_back(n);
+  }
+  std::vector<std::string> problems;
   Identity id;
-  if (find_user(user, id)) {
+  const bool have_user = find_user(user, id);
+  for (const auto& [folder, these] : folders) {
+    const feedback::SoundBank bank = feedback::load_sound_bank(folder, these, 1.0f);
+    problems.insert(problems.end(), bank.problems.begin(), bank.problems.end());
+    if (!have_user) continue;
     struct stat st {};
-    if (stat(dir.c_str(), &st) == 0 && !may(id, st, 5))
-      problems.push_back("'" + user + "' cannot open the folder " + dir + " (" + owner_text(st) + ")");
-    for (const auto& n : names) {
-      const std::string p = dir + "/" + n + ".wav";
+    if (stat(folder.c_str(), &st) == 0 && !may(id, st, 5))
+      problems.push_back("'" + user + "' cannot open the folder " + folder + " (" + owner_text(st) + ")");
+    for (const auto& n : these) {
+      const std::string p = folder + "/" + n + ".wav";
       if (stat(p.c_str(), &st) == 0 && !may(id, st, 4))
         problems.push_back("'" + user + "' cannot read " + p + " (" + owner_text(st) + ")");
     }
@@ -462,7 +482,8 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
             "source tree's sounds/ into " + dir + " (16-bit mono, readable by everyone)";
     return c;
   }
-  c.message = "all " + std::to_string(names.size()) + " cues are in " + dir + " and readable";
+  c.message = "all " + std::to_string(names.size()) + " cues are in " + dir +
+              (set.speech_dir != dir ? " (the words in " + set.speech_dir + ")" : std::string()) + " and readable";
   return c;
 }
 
