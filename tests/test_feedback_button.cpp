@@ -59,8 +59,9 @@ TEST(ButtonDecoder, ShortLongAndDouble) {
 TEST(ButtonDecoder, BouncesAreNotPresses) {
   // Contact bounce of a few ms on the press and on the release: one short press, its release timed
   // from the edge that settled (1.25 s).
-  EXPECT_EQ(decode({{1.0, true}, {1.004, false}, {1.006, true}, {1.2, false}, {1.22, true}, {1.25, false}}, 3.0),
-            (std::vector<std::string>{"short@1.65"}));
+  EXPECT_EQ(
+      decode({{1.0, true}, {1.004, false}, {1.006, true}, {1.2, false}, {1.22, true}, {1.25, false}}, 3.0),
+      (std::vector<std::string>{"short@1.65"}));
   // A spike shorter than the debounce: nothing.
   EXPECT_EQ(decode({{1.0, true}, {1.01, false}}, 3.0), (std::vector<std::string>{}));
   // The same level reported twice changes nothing.
@@ -84,10 +85,12 @@ TEST(ButtonFileLine, ReadsTimedEdgesAndNamesBadLines) {
   EXPECT_NEAR(edges[1].t - edges[0].t, 0.15, 1e-6);  // the file's times, not the reading's
   EXPECT_GE(steady_seconds() - t0, 0.29);            // each given at its time, not before
   ASSERT_EQ(warnings.size(), 2u);
-  EXPECT_NE(warnings[0].find("file:" + f.string() + " line 4: expected '<seconds> down|up', found 'bogus line'"),
-            std::string::npos)
+  EXPECT_NE(
+      warnings[0].find("file:" + f.string() + " line 4: expected '<seconds> down|up', found 'bogus line'"),
+      std::string::npos)
       << warnings[0];
-  EXPECT_NE(warnings[1].find("line 5: time 0.1 s is before the line above it"), std::string::npos) << warnings[1];
+  EXPECT_NE(warnings[1].find("line 5: time 0.1 s is before the line above it"), std::string::npos)
+      << warnings[1];
   // Lines appended later are read (the file is followed as it grows).
   std::ofstream(f, std::ios::app) << "0.31 up\n";
   edges.clear();
@@ -101,7 +104,8 @@ TEST(ButtonFileLine, MissingFileIsNamed) {
     FileButtonLine line((kDir / "no_such_presses").string(), nullptr);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("button: cannot open the press file '"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("button: cannot open the press file '"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("no_such_presses"), std::string::npos) << e.what();
   }
 }
@@ -111,8 +115,9 @@ TEST(ButtonGpiodLine, MissingChipIsNamed) {
     make_button_line("gpiochip_sg_absent", 27, true, nullptr);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("button: GPIO chip 'gpiochip_sg_absent' line 27: cannot open the chip"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("button: GPIO chip 'gpiochip_sg_absent' line 27: cannot open the chip"),
+        std::string::npos)
         << e.what();
   }
 }

@@ -33,7 +33,7 @@ double steady_seconds() {
 // ---------------------------------------------------------------- decoder
 
 void PressDecoder::edge(const ButtonEdge& e, std::vector<PressEvent>& out) {
-  advance(e.t, out);  // what the level did before this edge is decided first
+  advance(e.t, out);           // what the level did before this edge is decided first
   if (e.down == raw_) return;  // no change (a repeated report)
   raw_ = e.down;
   raw_t_ = e.t;
@@ -93,7 +93,8 @@ struct GpiodButtonLine::Impl {
   gpiod::line line;
 };
 
-GpiodButtonLine::GpiodButtonLine(const std::string& chip, int line, bool active_low, const std::string& consumer)
+GpiodButtonLine::GpiodButtonLine(const std::string& chip, int line, bool active_low,
+                                 const std::string& consumer)
     : impl_(std::make_unique<Impl>()) {
   desc_ = "gpiod:" + chip + ":" + std::to_string(line);
   const std::string what = "button: GPIO chip '" + chip + "' line " + std::to_string(line) + ": ";
@@ -147,7 +148,8 @@ FileButtonLine::FileButtonLine(const std::string& path, std::function<void(const
   // Non-blocking: a FIFO opens at once with no writer yet, and a read never waits.
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0)
-    throw std::runtime_error("button: cannot open the press file '" + path + "' (" + std::strerror(errno) + ")");
+    throw std::runtime_error("button: cannot open the press file '" + path + "' (" + std::strerror(errno) +
+                             ")");
   t0_ = steady_seconds();
 }
 
@@ -163,8 +165,8 @@ void FileButtonLine::parse_line(const std::string& raw) {
   if (!(is >> when)) return;  // blank or a comment
   char* end = nullptr;
   const double t = std::strtod(when.c_str(), &end);
-  const bool ok = *end == '\0' && std::isfinite(t) && t >= 0 && (is >> what) && (what == "down" || what == "up") &&
-                  !(is >> extra);
+  const bool ok = *end == '\0' && std::isfinite(t) && t >= 0 && (is >> what) &&
+                  (what == "down" || what == "up") && !(is >> extra);
   const std::string where = "button: " + describe() + " line " + std::to_string(line_no_) + ": ";
   if (!ok) {
     if (warn_) warn_(where + "expected '<seconds> down|up', found '" + raw + "'; skipped");
@@ -243,7 +245,8 @@ void ButtonReader::run() {
   while (!stop_.load()) {
     // Wake for the decoder's next decision, and at least every 100 ms to see a stop.
     const double left_ms = (decoder_.next_deadline() - steady_seconds()) * 1e3;
-    const auto wait = std::chrono::milliseconds(static_cast<long>(std::clamp(std::ceil(left_ms), 0.0, 100.0)));
+    const auto wait =
+        std::chrono::milliseconds(static_cast<long>(std::clamp(std::ceil(left_ms), 0.0, 100.0)));
     edges.clear();
     try {
       line_->wait(wait, edges);

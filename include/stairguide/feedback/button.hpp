@@ -67,12 +67,12 @@ class PressDecoder {
  private:
   void accept(double t, bool down, std::vector<PressEvent>& out);
   PressTiming tm_;
-  bool raw_ = false;       // the line's last raw level ...
-  double raw_t_ = -1e9;    // ... since
-  bool level_ = false;     // debounced
-  double down_t_ = 0.0;    // when the press being held began
-  bool long_told_ = false;  // ... and it has been told as a long press
-  bool second_ = false;     // ... and it is the second of a double press
+  bool raw_ = false;             // the line's last raw level ...
+  double raw_t_ = -1e9;          // ... since
+  bool level_ = false;           // debounced
+  double down_t_ = 0.0;          // when the press being held began
+  bool long_told_ = false;       // ... and it has been told as a long press
+  bool second_ = false;          // ... and it is the second of a double press
   bool single_pending_ = false;  // a short press released at release_t_, waiting for a second
   double release_t_ = 0.0;
 };
@@ -92,7 +92,8 @@ class ButtonLine {
 /// chip and line and what failed (no such chip, line busy, permission) when it cannot be requested.
 class GpiodButtonLine : public ButtonLine {
  public:
-  GpiodButtonLine(const std::string& chip, int line, bool active_low, const std::string& consumer = "stairguide-button");
+  GpiodButtonLine(const std::string& chip, int line, bool active_low,
+                  const std::string& consumer = "stairguide-button");
   ~GpiodButtonLine() override;
   void wait(std::chrono::milliseconds timeout, std::vector<ButtonEdge>& out) override;
   std::string describe() const override { return desc_; }
@@ -144,7 +145,8 @@ std::unique_ptr<ButtonLine> make_button_line(const std::string& chip, int line, 
 /// thread). A line that fails is reported once through `warn` and read no more.
 class ButtonReader {
  public:
-  ButtonReader(std::unique_ptr<ButtonLine> line, PressTiming timing, std::function<void(const std::string&)> warn);
+  ButtonReader(std::unique_ptr<ButtonLine> line, PressTiming timing,
+               std::function<void(const std::string&)> warn);
   ~ButtonReader();
   std::vector<PressEvent> take();
   std::string describe() const { return line_->describe(); }
