@@ -771,6 +771,13 @@ TEST(FeedbackButton, ShortPressOnAFlightSaysTheStepsLeft) {
   const CueEvent w = last_of(feed(p, {pressed(in, Press::kShort)}), Cue::kWhere);
   EXPECT_EQ(token(w), "where:4_left");
   EXPECT_EQ(clips_for(w), (std::vector<std::string>{"n4", "steps_left"}));
+  // Steps left not known yet: the way the flight goes, never "no stairs".
+  in.t = 2 * kDt;
+  in.traversal.steps_left = -1;
+  in.traversal.direction = -1;
+  const CueEvent u = last_of(feed(p, {pressed(in, Press::kShort)}), Cue::kWhere);
+  EXPECT_EQ(token(u), "where_down");
+  EXPECT_EQ(clips_for(u), (std::vector<std::string>{"stairs_down"}));
 }
 
 // A long press mutes (said and felt) for mute_s: the ascending staircase is not told, the drop

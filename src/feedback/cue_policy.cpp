@@ -390,8 +390,11 @@ CueEvent CuePolicy::where_event(double t) const {
   CueEvent e;
   e.cue = Cue::kWhere;
   if (on_flight(prev_state_)) {  // the staircase is under the feet: how much of it is left
-    e.number = flight_left_ >= 1 ? flight_left_ : -1;
-    e.direction = flight_dir_;
+    e.direction = flight_dir_ < 0 ? -1 : 1;
+    if (flight_left_ >= 1)
+      e.number = flight_left_;
+    else  // not known yet: which way the stairs go on
+      e.kind = e.direction > 0 ? StairKind::kAscending : StairKind::kDescending;
     return e;
   }
   const bool held = told_.active && t - told_.last_seen_t <= cfg_.forget_time && held_.present;

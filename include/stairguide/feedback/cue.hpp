@@ -33,7 +33,8 @@ enum class Cue {
   kSlow,             ///< perception has fallen behind the camera for long enough to matter
   // Answers to the wearer's button (button.hpp):
   kWhere,      ///< short press: the nearest known staircase (`kind`, `direction`, `number` metres,
-               ///< `clock`), steps left on a flight (`number`), or none known (`kind` kNone)
+               ///< `clock`), steps left on a flight (`number`; not known: the flight's `kind`
+               ///< and `direction`), or none known (`kind` kNone, `number` -1)
   kMuted,      ///< long press: the cues are muted for `number` s (a descent still warns)
   kUnmuted,    ///< the mute is over (its time, or another long press)
   kVerbosity,  ///< double press: the verbosity is now `number` (0 quiet, 1 normal, 2 verbose)

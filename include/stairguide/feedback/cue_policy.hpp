@@ -33,11 +33,12 @@
 ///
 /// - The wearer's button (`presses`, or between_frames() when no frame comes): a short press is
 ///   answered with where the staircase held in mind is (kWhere: kind, up or down, metres, clock
-///   position, said even at 12), the steps left on a flight, or "no stairs"; a long press mutes
-///   every cue for `mute` s (kMuted; another long press or the time's end: kUnmuted), except what
-///   warns of a descent (the drop warning, the approach beep) and the answers to the button; a
-///   double press cycles the verbosity quiet -> normal -> verbose -> quiet (kVerbosity). What is
-///   muted is not told later (a short press asks). A reload that changes `verbosity` sets it again.
+///   position, said even at 12), the steps left on a flight (or which way it goes), or "no
+///   stairs"; a long press mutes every cue for `mute` s (kMuted; another long press or the
+///   time's end: kUnmuted), except what warns of a descent (the drop warning, the approach beep)
+///   and the answers to the button; a double press cycles the verbosity quiet -> normal ->
+///   verbose -> quiet (kVerbosity). What is muted is not told later (a short press asks). A
+///   reload that changes `verbosity` sets it again.
 ///
 /// Verbosity: quiet = warnings (drop, last step, blind, camera) and earcons for stairs and steps
 /// ahead; normal = the words for what is ahead, first step, ticks, counts every `count_interval`
