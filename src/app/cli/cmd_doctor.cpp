@@ -38,6 +38,7 @@
 #include "stairguide/config/config_loader.hpp"
 #include "stairguide/core/json.hpp"
 #include "stairguide/feedback/audio_sink.hpp"
+#include "stairguide/feedback/button.hpp"
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/sound_bank.hpp"
@@ -266,6 +267,29 @@ Check check_buzzer(const FeedbackConfig& cfg) {
     c.fix = "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.gpio_chip and "
             "feedback.gpio_line to the buzzer's (or feedback.haptic_enabled: false for none); a line "
             "'used' by another program must be freed first";
+  }
+  return c;
+}
+
+// ---- 4b. the wearer's button (only when the config asks for one) ------------------------------
+
+Check check_button(const FeedbackConfig& cfg) {
+  Check c{"button"};
+  const bool file = cfg.button_chip.rfind("file:", 0) == 0;  // a test button reading presses from a file
+  const std::string where = file ? "the button's presses file " + cfg.button_chip.substr(5) + " (a test button)"
+                                 : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
+  try {
+    const auto line = feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
+    c.message = where + (file ? " opened" : " requested for its edges") +
+                ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
+  } catch (const std::exception& e) {
+    c.status = Status::kFail;
+    std::string why = e.what();
+    if (why.rfind("button: ", 0) == 0) why.erase(0, 8);
+    c.message = "cannot use the button: " + why;
+    c.fix = "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.button_chip and "
+            "feedback.button_line to the button's (or feedback.button_enabled: false for none); the user must "
+            "be in group gpio";
   }
   return c;
 }
@@ -576,6 +600,7 @@ int doctor(Context& ctx) {
   run(held(check_camera(config.capture)));
   run(held(check_sound(config.feedback)));
   run(held(check_buzzer(config.feedback)));
+  if (config.feedback.button_enabled) run(held(check_button(config.feedback)));
   run(check_user(user, ctx.config_path, user == "stairguide"));
   run(check_sounds(config.feedback, user));
   run(check_rig());
@@ -608,7 +633,8 @@ int doctor(Context& ctx) {
 }  // namespace
 
 SG_COMMAND("doctor", "doctor [--json] [--user NAME]",
-           "check config, camera, sound, buzzer, service user, sounds and the running daemon; say how to fix "
+           "check config, camera, sound, buzzer, button (when enabled), service user, sounds and the running "
+           "daemon; say how to fix "
            "what is wrong (exit 0 when all is well)",
            doctor);
 
