@@ -72,11 +72,12 @@ inline double energy(const std::vector<std::int16_t>& s, std::size_t from = 0, s
   return e;
 }
 
-inline std::vector<std::int16_t> clip(const std::string& name) {
+/// The samples of clip `name` of `dir` (the English set by default; sounds_dir()/es for Spanish).
+inline std::vector<std::int16_t> clip(const std::string& name, const std::string& dir = sounds_dir()) {
   std::vector<std::int16_t> s;
   int rate = 0;
   std::string why;
-  stairguide::feedback::read_wav(sounds_dir() + "/" + name + ".wav", s, rate, why);
+  stairguide::feedback::read_wav(dir + "/" + name + ".wav", s, rate, why);
   return s;
 }
 
@@ -86,11 +87,11 @@ struct Hit {
   double score = 0.0;
 };
 
-/// Every place `name`'s WAV occurs in `cap` with a normalised correlation above `min_score`
-/// (peaks at least a clip's length apart).
+/// Every place `name`'s WAV (of `dir`) occurs in `cap` with a normalised correlation above
+/// `min_score` (peaks at least a clip's length apart).
 inline std::vector<Hit> find_all(const std::vector<std::int16_t>& cap, const std::string& name,
-                                 double min_score = 0.97) {
-  const std::vector<std::int16_t> c = clip(name);
+                                 double min_score = 0.97, const std::string& dir = sounds_dir()) {
+  const std::vector<std::int16_t> c = clip(name, dir);
   std::vector<Hit> hits;
   if (c.empty() || cap.size() < c.size()) return hits;
   cv::Mat a(1, static_cast<int>(cap.size()), CV_32F), t(1, static_cast<int>(c.size()), CV_32F), r;

@@ -204,7 +204,8 @@ TEST(Doctor, AMissingCueAndAMissingUserAreNamed) {
   fs::remove_all(sounds);
   fs::create_directories(sounds);
   for (const auto& e : fs::directory_iterator(fs::path(STAIRGUIDE_SOURCE_DIR) / "sounds"))
-    if (e.path().filename() != "last_step.wav") fs::copy_file(e.path(), sounds / e.path().filename());
+    if (e.is_regular_file() && e.path().filename() != "last_step.wav")  // the English set, not es/, de/, ...
+      fs::copy_file(e.path(), sounds / e.path().filename());
   PipelineConfig c = null_sound_config();
   c.feedback.sounds_dir = sounds.string();
   const fs::path config = write_config("nocue", c);
@@ -241,4 +242,48 @@ TEST(Doctor, ARunningDaemonIsNamedAndIsNoFailure) {
                                                            std::to_string(d.pid()) + "\\b")))
       << rig->message;
   EXPECT_EQ(failed_list(j.out).find("rig"), std::string::npos) << j.out;
+}
+
+// The button is checked only when the config enables it: a chip that is not there fails naming the
+// chip and the line, with a fix; a file button (the tests' backend) passes; with the button off the
+// check is not in the list at all (WithoutCameraAndGpio...), and the language's words are checked.
+TEST(Doctor, TheButtonWhenEnabledAndTheLanguagesWords) {
+  PipelineConfig c = null_sound_config();
+  c.feedback.haptic_enabled = false;
+  c.feedback.button_enabled = true;
+  c.feedback.button_chip = "gpiochip_sg_absent";
+  c.feedback.button_line = 5;
+  c.feedback.language = "es";
+  cli_test::CliRun j = doctor(write_config("button", c), "--json");
+  auto checks = parse_checks(j.out);
+  std::vector<std::string> order;
+  for (const auto& k : checks) order.push_back(k.name);
+  EXPECT_EQ(order, (std::vector<std::string>{"config", "camera", "sound", "buzzer", "button", "user", "sounds", "rig"}))
+      << j.out;
+  const JsonCheck* b = find(checks, "button");
+  ASSERT_NE(b, nullptr) << j.out;
+  EXPECT_EQ(b->status, "fail");
+  EXPECT_NE(b->message.find("cannot use the button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip"),
+            std::string::npos)
+      << b->message;
+  EXPECT_NE(b->fix.find("feedback.button_chip"), std::string::npos) << b->fix;
+  const JsonCheck* s = find(checks, "sounds");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->status, "ok") << s->message;
+  EXPECT_NE(s->message.find("(the words in " + std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds/es)"), std::string::npos)
+      << s->message;
+
+  const fs::path presses = kDir / "doctor.presses";
+  std::ofstream(presses) << "";
+  c.feedback.button_chip = "file:" + presses.string();
+  c.feedback.language = "xx";
+  j = doctor(write_config("button_file", c), "--json");
+  checks = parse_checks(j.out);
+  b = find(checks, "button");
+  ASSERT_NE(b, nullptr) << j.out;
+  EXPECT_EQ(b->status, "ok") << b->message;
+  s = find(checks, "sounds");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->status, "fail");
+  EXPECT_NE(s->message.find("no sounds for language 'xx'"), std::string::npos) << s->message;
 }

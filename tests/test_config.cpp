@@ -364,3 +364,31 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
   // Equal bounds stay allowed where they mean something (a single accepted value).
   EXPECT_NO_THROW(load_config_text("floor:\n  usual_height_min_m: 1.2\n  usual_height_max_m: 1.2\n", "eq.yaml"));
 }
+
+// The button's and the language's keys: ranges, the buzzer's line refused for the button, a
+// language that is a path refused; a good set loads in SI.
+TEST(Config, ButtonAndLanguageKeysAreValidated) {
+  std::string e = error_of("mute", "feedback:\n  mute_s: 0.5\n");
+  EXPECT_NE(e.find("test_config_mute.yaml:2: key 'feedback.mute_s': value 0.5 is out of range [1, 7200] s"),
+            std::string::npos)
+      << e;
+  e = error_of("button_line", "feedback:\n  button_enabled: true\n  button_line: 17\n");
+  EXPECT_NE(e.find("test_config_button_line.yaml:3: key 'feedback.button_line'"), std::string::npos) << e;
+  EXPECT_NE(e.find("is the buzzer's line"), std::string::npos) << e;
+  e = error_of("debounce", "feedback:\n  button_debounce_s: 0.2\n  button_double_press_s: 0.15\n");
+  EXPECT_NE(e.find("feedback.button_debounce_s must be below feedback.button_double_press_s"), std::string::npos) << e;
+  e = error_of("language", "feedback:\n  language: \"../etc\"\n");
+  EXPECT_NE(e.find("test_config_language.yaml:2: key 'feedback.language': feedback.language '../etc' is not a "
+                   "language name"),
+            std::string::npos)
+      << e;
+  const PipelineConfig c = load_config_text(
+      "feedback:\n  button_enabled: true\n  button_chip: \"file:/tmp/p\"\n  button_long_press_s: 1.5\n"
+      "  mute_s: 600\n  language: \"es\"\n",
+      "inline.yaml");
+  EXPECT_TRUE(c.feedback.button_enabled);
+  EXPECT_EQ(c.feedback.button_chip, "file:/tmp/p");
+  EXPECT_FLOAT_EQ(c.feedback.button_long_press, 1.5f);
+  EXPECT_FLOAT_EQ(c.feedback.mute, 600.f);
+  EXPECT_EQ(c.feedback.language, "es");
+}

@@ -314,3 +314,209 @@ TEST(E2eFeedback, BatteryLowAndCriticalAreSaidFromTheSysfsFolder) {
     }
   }
 }
+
+// ---------------------------------------------------------------- the wearer's button
+
+namespace {
+
+/// Every cue token the daemon logged, in order: those of frames ("frame N: cue A+B") and those
+/// given between frames ("cue A (button)"), each '+'-joined list split.
+std::vector<std::string> logged_cues(const std::string& log) {
+  std::vector<std::string> out;
+  std::istringstream is(log);
+  for (std::string line; std::getline(is, line);) {
+    std::size_t at = line.find(": cue ");
+    if (at != std::string::npos) {
+      at += 6;
+    } else if ((at = line.find("] cue ")) != std::string::npos) {
+      at += 6;
+    } else {
+      continue;
+    }
+    std::istringstream tok(line.substr(at));
+    std::string list;
+    tok >> list;
+    std::istringstream parts(list);
+    for (std::string one; std::getline(parts, one, '+');) out.push_back(one);
+  }
+  return out;
+}
+
+/// The presses file of a run: the button's "file:" backend reads it from the daemon's start.
+std::string press_file(const std::string& name, const std::string& lines) {
+  const fs::path p = kDir / (name + ".presses");
+  fs::create_directories(kDir);
+  std::ofstream(p) << lines;
+  return "  button_enabled: true\n  button_chip: \"file:" + p.string() + "\"\n";
+}
+
+/// The pulses felt (on-durations in ms, from the edge file), in order.
+std::vector<double> pulses(const std::vector<std::pair<double, int>>& edges) {
+  std::vector<double> on;
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+    if (edges[i].second == 1 && edges[i + 1].second == 0) on.push_back(edges[i + 1].first - edges[i].first);
+  return on;
+}
+
+bool has_flutter(const std::vector<double>& on) {  // the "muted" pattern: four 40 ms taps in a row
+  for (std::size_t i = 0; i + 4 <= on.size(); ++i)
+    if (std::all_of(on.begin() + i, on.begin() + i + 4, [](double ms) { return std::fabs(ms - 40.0) < 15.0; }))
+      return true;
+  return false;
+}
+
+}  // namespace
+
+// A short press with no staircase in mind says "no stairs"; a double press moves the verbosity
+// from normal to verbose (said); a long press mutes (said, and felt as four taps) for mute_s, and
+// the end of the mute is said ("sound on") and felt (one 150 ms pulse). Presses from a file, as the
+// wearer's fingers would give them, through the whole daemon.
+TEST(E2eFeedback, ButtonAsksMutesAndChangesTheVerbosity) {
+  const std::string presses = press_file("e2e_button", "# short, double, long\n0.5 down\n0.6 up\n"
+                                                       "1.2 down\n1.3 up\n1.45 down\n1.55 up\n"
+                                                       "2.5 down\n3.9 up\n");
+  const Result r = run_daemon("e2e_button", "synth:corridor_static:210", "--realtime", presses + "  mute_s: 2\n");
+  ASSERT_EQ(r.code, 0) << r.log;
+  std::vector<std::string> told;
+  for (const auto& c : logged_cues(r.log))
+    if (c != "ready") told.push_back(c);
+  EXPECT_EQ(told, (std::vector<std::string>{"where_none", "verbosity_verbose", "muted:2", "unmuted"})) << r.log;
+  EXPECT_NE(r.log.find("button: reading presses on file:"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("button: short press"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("button: double press"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("button: long press"), std::string::npos) << r.log;
+  const auto names =
+      sgtest::names_of(sgtest::heard(r.audio, {"ready", "no_stairs", "verbose", "muted", "unmuted", "normal"}));
+  std::printf("button: told %s; heard %s\n", ::testing::PrintToString(told).c_str(),
+              ::testing::PrintToString(names).c_str());
+  EXPECT_EQ(names, (std::vector<std::string>{"ready", "no_stairs", "verbose", "muted", "unmuted"}));
+  // Felt: the ready pulse, the mute's four taps, the unmute's pulse.
+  const auto on = pulses(r.edges);
+  EXPECT_TRUE(has_flutter(on)) << ::testing::PrintToString(on);
+  ASSERT_GE(on.size(), 6u) << ::testing::PrintToString(on);
+  EXPECT_NEAR(on.back(), 150.0, 15.0);
+  // The mute lasted its 2 s on the policy's clock (the frames' timestamps, carried on between
+  // frames): "sound on" at least 2 s after "muted" in the heard stream (a time line). A replay on a
+  // loaded machine runs slower than its timestamps (13.6 fps of 30 seen on 2 shared cores), so the
+  // heard gap may be longer by as much, never shorter.
+  const auto muted = sgtest::find_all(r.audio, "muted"), unmuted = sgtest::find_all(r.audio, "unmuted");
+  ASSERT_EQ(muted.size(), 1u);
+  ASSERT_EQ(unmuted.size(), 1u);
+  const double gap = (unmuted[0].pos - muted[0].pos) / double(stairguide::feedback::kSoundRate);
+  const auto ended = r.log.find("ended: 210 frames, ");
+  ASSERT_NE(ended, std::string::npos) << r.log;
+  const double fps = std::atof(r.log.c_str() + ended + std::strlen("ended: 210 frames, "));
+  ASSERT_GT(fps, 1.0) << r.log;
+  EXPECT_GE(gap, 2.0 - 0.05);
+  EXPECT_LE(gap, 2.0 * std::max(1.0, 30.0 / fps) + 0.5) << "replayed at " << fps << " fps";
+}
+
+// Asked with an ascending staircase in view: where it is (going up, its metres, its clock
+// position), heard from the stairs' clips: "stairs ahead, going up" twice (told, then answered).
+TEST(E2eFeedback, ButtonShortPressSaysWhereTheStairsAre) {
+  const std::string presses = press_file("e2e_button_where", "2.5 down\n2.6 up\n");
+  const Result r = run_daemon("e2e_button_where", "synth:ascending_approach_climb:120", "--realtime", presses);
+  ASSERT_EQ(r.code, 0) << r.log;
+  std::vector<std::string> where;
+  for (const auto& c : logged_cues(r.log))
+    if (c.rfind("where", 0) == 0) where.push_back(c);
+  ASSERT_EQ(where.size(), 1u) << r.log;
+  EXPECT_EQ(where[0].rfind("where_up:", 0), 0u) << where[0];
+  EXPECT_NE(where[0].find("m@"), std::string::npos) << where[0];  // metres and clock position
+  const auto names = sgtest::names_of(sgtest::heard(r.audio, {"stairs_up", "oclock", "no_stairs"}));
+  std::printf("where: %s; heard %s\n", where[0].c_str(), ::testing::PrintToString(names).c_str());
+  EXPECT_EQ(std::count(names.begin(), names.end(), "stairs_up"), 2) << ::testing::PrintToString(names);
+  EXPECT_EQ(std::count(names.begin(), names.end(), "no_stairs"), 0);
+  EXPECT_GE(std::count(names.begin(), names.end(), "oclock"), 1) << "the clock position is said when asked";
+}
+
+// Muted before a descent comes into view: the drop warning is still given and heard (a danger is
+// never muted), while the muted run says nothing else.
+TEST(E2eFeedback, MutedDescentStillWarns) {
+  const std::string presses = press_file("e2e_button_mute_down", "0.0 down\n1.2 up\n");
+  const Result r = run_daemon("e2e_button_mute_down", "synth:descending_approach_descend:150", "--realtime",
+                              presses + "  mute_s: 60\n");
+  ASSERT_EQ(r.code, 0) << r.log;
+  const auto told = logged_cues(r.log);
+  std::printf("muted descent: told %s\n", ::testing::PrintToString(told).c_str());
+  EXPECT_NE(std::find(told.begin(), told.end(), "muted:60"), told.end()) << r.log;
+  int warnings = 0;
+  for (const auto& c : told) {
+    warnings += c.rfind("drop_warning_down", 0) == 0;
+    EXPECT_TRUE(c.rfind("drop_warning", 0) == 0 || c.rfind("approach", 0) == 0 || c == "muted:60" || c == "ready")
+        << c;
+  }
+  EXPECT_EQ(warnings, 1) << ::testing::PrintToString(told);
+  EXPECT_EQ(sgtest::find_all(r.audio, "warning").size(), 1u);
+  EXPECT_TRUE(sgtest::find_all(r.audio, "stairs_up").empty());
+}
+
+TEST(E2eFeedback, MissingButtonChipIsNamedAndTheDaemonGoesOn) {
+  fs::create_directories(kDir);
+  const fs::path conf = kDir / "e2e_nobutton.yaml";
+  std::ofstream(conf) << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir()
+                      << "\"\n  button_enabled: true\n  button_chip: \"gpiochip_sg_absent\"\n  button_line: 5\n";
+  std::string out;
+  const std::string cmd = std::string(STAIRGUIDED) + " --config " + conf.string() +
+                          " --replay synth:corridor_static:10 --fast --sync --audio null --no-haptic 2>&1";
+  std::FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = pclose(p);
+  EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 0) << out;
+  EXPECT_NE(out.find("button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip ("), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("going on without the button"), std::string::npos) << out;
+  EXPECT_NE(out.find("summary frames=10"), std::string::npos) << out;
+}
+
+// ---------------------------------------------------------------- slow, through the daemon
+
+// Perception held 0.7 s a frame (a machine that cannot keep up with the camera): every frame is
+// decided more than slow_lag_s (0.5 s) after its capture, and after slow_after_s (3 s) "system
+// slow" is said once and heard; the same walk at full speed says nothing of it (the other runs).
+TEST(E2eFeedback, SlowIsHeardWhenPerceptionFallsBehind) {
+  const Result r = run_daemon("e2e_slow", "synth:corridor_static:180", "--realtime --perception-delay 0.7");
+  ASSERT_EQ(r.code, 0) << r.log;
+  std::vector<std::pair<double, std::string>> slow;
+  for (const auto& [ts, tok] : r.told)
+    if (tok == "slow") slow.push_back({ts, tok});
+  ASSERT_EQ(slow.size(), 1u) << ::testing::PrintToString(r.cues) << r.log;
+  EXPECT_GE(slow[0].first, 3.0);  // not before perception has been behind for slow_after_s
+  EXPECT_EQ(sgtest::names_of(sgtest::heard(r.audio, {"slow"})), (std::vector<std::string>{"slow"}));
+  EXPECT_NE(r.log.find("--perception-delay 0.700 s"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- languages
+
+// language: es speaks the Spanish clips (the heard samples are the Spanish "ready", not the
+// English one); a language with no folder is named in the log and English is spoken.
+TEST(E2eFeedback, LanguagePicksItsSoundsAndFallsBackToEnglish) {
+  const std::string es = sgtest::sounds_dir() + "/es";
+  Result r = run_daemon("e2e_lang_es", "synth:corridor_static:30", "--fast --sync", "  language: \"es\"\n");
+  ASSERT_EQ(r.code, 0) << r.log;
+  EXPECT_NE(r.log.find("audio: cues in es (" + es + ")"), std::string::npos) << r.log;
+  const auto es_ready = sgtest::find_all(r.audio, "ready", 0.97, es);
+  ASSERT_EQ(es_ready.size(), 1u) << r.log;
+  EXPECT_GE(es_ready[0].score, 0.99);  // the very samples of sounds/es/ready.wav
+  EXPECT_TRUE(sgtest::find_all(r.audio, "ready", 0.9).empty()) << "the English clip was heard";
+  // Sample for sample: the heard "listo" is the clip, scaled by the volume (0.8) and panned centre.
+  const auto clip = sgtest::clip("ready", es);
+  double dot = 0, cc = 0, hh = 0;
+  for (std::size_t i = 0; i < clip.size(); ++i) {
+    const double h = r.audio[static_cast<std::size_t>(es_ready[0].pos) + i];
+    dot += h * clip[i];
+    cc += double(clip[i]) * clip[i];
+    hh += h * h;
+  }
+  EXPECT_GT(dot / std::sqrt(cc * hh), 0.999);
+
+  r = run_daemon("e2e_lang_pt", "synth:corridor_static:30", "--fast --sync", "  language: \"pt\"\n");
+  ASSERT_EQ(r.code, 0) << r.log;
+  EXPECT_NE(r.log.find("no sounds for language 'pt' (feedback.language): " + sgtest::sounds_dir() +
+                       "/pt is not a folder; speaking English"),
+            std::string::npos)
+      << r.log;
+  EXPECT_EQ(sgtest::find_all(r.audio, "ready").size(), 1u);
+}

@@ -483,3 +483,42 @@ TEST(FeedbackAlsa, MonoDeviceIsServedMono) {
   ASSERT_EQ(info.size(), 1u);
   EXPECT_NE(info[0].find("refused two channels"), std::string::npos) << info[0];
 }
+
+// Every language's folder (tools/make-sounds --lang L) has the words of every clip the English set
+// has, numbers included, and no earcon (those are shared from sounds/ itself); each is a short
+// 16-bit mono clip at the sink's rate. en, es, de and fr at least.
+TEST(FeedbackSounds, EveryLanguageHasEveryWord) {
+  std::vector<std::string> words;
+  for (const auto& n : all_clip_names())
+    if (!is_earcon_clip(n)) words.push_back(n);
+  std::vector<std::string> langs;
+  for (const auto& e : fs::directory_iterator(sgtest::sounds_dir()))
+    if (e.is_directory()) langs.push_back(e.path().filename().string());
+  for (const char* l : {"es", "de", "fr"})
+    EXPECT_NE(std::find(langs.begin(), langs.end(), l), langs.end()) << "no sounds/" << l;
+  for (const auto& l : langs) {
+    const std::string dir = sgtest::sounds_dir() + "/" + l;
+    const SoundBank b = load_sound_bank(dir, words, 1.0f);
+    EXPECT_TRUE(b.problems.empty()) << l << ": " << ::testing::PrintToString(b.problems);
+    for (const auto& [name, s] : b.clips) EXPECT_LE(static_cast<double>(s.size()) / kSoundRate, 2.0) << l << "/" << name;
+    std::size_t files = 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      ++files;
+      EXPECT_FALSE(is_earcon_clip(e.path().stem().string())) << l << ": " << e.path();
+    }
+    EXPECT_EQ(files, words.size()) << l;
+    // The words are the language's own: "ready" differs from the English clip.
+    EXPECT_NE(b.find("ready") ? *b.find("ready") : std::vector<std::int16_t>{}, sgtest::clip("ready")) << l;
+  }
+  // The set a language names: its folder, the earcons from the top; a missing one falls back.
+  const SoundSet es = sound_set_for(sgtest::sounds_dir(), "es");
+  EXPECT_EQ(es.speech_dir, sgtest::sounds_dir() + "/es");
+  EXPECT_EQ(es.earcon_dir, sgtest::sounds_dir());
+  EXPECT_TRUE(es.problem.empty());
+  const SoundSet en = sound_set_for(sgtest::sounds_dir(), "en");
+  EXPECT_EQ(en.speech_dir, sgtest::sounds_dir());
+  const SoundSet xx = sound_set_for(sgtest::sounds_dir(), "xx");
+  EXPECT_EQ(xx.speech_dir, sgtest::sounds_dir());
+  EXPECT_EQ(xx.language, "en");
+  EXPECT_NE(xx.problem.find("no sounds for language 'xx'"), std::string::npos) << xx.problem;
+}

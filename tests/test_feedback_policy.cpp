@@ -4,6 +4,7 @@
 // TraversalResult sequences: the traversal tracker is another room's.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -712,4 +713,157 @@ TEST(FeedbackPolicy, SlowWhenPerceptionIsBehindLongEnough) {
   int n = 0;
   for (const auto& x : feed(r, g)) n += x.e.cue == Cue::kSlow;
   EXPECT_EQ(n, 2);
+}
+
+// ---------------------------------------------------------------- the wearer's button
+
+namespace {
+CueInput pressed(CueInput in, Press p) {
+  in.presses.push_back(p);
+  return in;
+}
+/// The last cue of kind `c` said (a default CueEvent of kReady when none).
+CueEvent last_of(const std::vector<Said>& s, Cue c) {
+  CueEvent e;
+  for (const auto& x : s)
+    if (x.e.cue == c) e = x.e;
+  return e;
+}
+}  // namespace
+
+// A short press says where the staircase held in mind is: up or down, its metres and its clock
+// position (said even straight ahead: the wearer asked where); "no stairs" when none is held (never
+// seen, or forgotten).
+TEST(FeedbackButton, ShortPressSaysWhereTheStairsAre) {
+  CuePolicy p{FeedbackConfig{}};
+  auto s = feed(p, {pressed(floor_frame(0.0), Press::kShort)});
+  ASSERT_EQ(toks(s), (std::vector<std::string>{"where_none", "ready"}));  // the answer is the more urgent
+  EXPECT_EQ(clips_for(s[0].e), (std::vector<std::string>{"no_stairs"}));
+  // An ascending staircase at 2 o'clock, told; then asked at 2.9 m.
+  auto f = approach(1.0, StairKind::kAscending, 3.9f, 1.0, static_cast<float>(M_PI / 3));
+  f.back() = pressed(f.back(), Press::kShort);
+  s = feed(p, f);
+  const CueEvent w = last_of(s, Cue::kWhere);
+  ASSERT_EQ(token(w), "where_up:3m@2") << ::testing::PrintToString(toks(s));
+  EXPECT_EQ(clips_for(w), (std::vector<std::string>{"stairs_up", "n3", "metres", "n2", "oclock"}));
+  EXPECT_NEAR(cue_pan(w), kMaxPan * 2.f / 3.f, 1e-5);  // heard from its side
+  // Straight ahead: "12 o'clock" is said.
+  CuePolicy q{FeedbackConfig{}};
+  f = approach(0.0, StairKind::kDescending, 3.6f, 1.0);
+  f.back() = pressed(f.back(), Press::kShort);
+  s = feed(q, f);
+  EXPECT_EQ(token(last_of(s, Cue::kWhere)), "where_down:3m@12");
+  // Forgotten (unseen 3 s): no stairs, between frames too.
+  const auto later = q.between_frames(5.0, {Press::kShort});
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_EQ(token(later[0]), "where_none");
+}
+
+TEST(FeedbackButton, ShortPressOnAFlightSaysTheStepsLeft) {
+  CuePolicy p{FeedbackConfig{}};
+  CueInput in = floor_frame(0.0);
+  in.traversal.ran = true;
+  in.traversal.state = TraversalState::kOnStairs;
+  in.traversal.direction = 1;
+  in.traversal.steps_left = 4;
+  feed(p, {in});
+  in.t = kDt;
+  const CueEvent w = last_of(feed(p, {pressed(in, Press::kShort)}), Cue::kWhere);
+  EXPECT_EQ(token(w), "where:4_left");
+  EXPECT_EQ(clips_for(w), (std::vector<std::string>{"n4", "steps_left"}));
+  // Steps left not known yet: the way the flight goes, never "no stairs".
+  in.t = 2 * kDt;
+  in.traversal.steps_left = -1;
+  in.traversal.direction = -1;
+  const CueEvent u = last_of(feed(p, {pressed(in, Press::kShort)}), Cue::kWhere);
+  EXPECT_EQ(token(u), "where_down");
+  EXPECT_EQ(clips_for(u), (std::vector<std::string>{"stairs_down"}));
+}
+
+// A long press mutes (said and felt) for mute_s: the ascending staircase is not told, the drop
+// warning of a descent is; the mute ends on its time with "unmuted" (said and felt), or at once on
+// another long press.
+TEST(FeedbackButton, LongPressMutesAllButTheDescentsWarnings) {
+  FeedbackConfig c;
+  c.mute = 20.f;
+  CuePolicy p{c};
+  auto s = feed(p, {pressed(floor_frame(0.0), Press::kLong)});
+  ASSERT_EQ(toks(s), (std::vector<std::string>{"muted:20"})) << "ready is muted too";
+  EXPECT_FALSE(haptic_pattern(s[0].e).empty());
+  EXPECT_EQ(clips_for(s[0].e), (std::vector<std::string>{"muted"}));
+  EXPECT_TRUE(p.muted());
+  s = feed(p, approach(1.0, StairKind::kAscending, 3.5f, 2.0));
+  EXPECT_EQ(count_of(s, Cue::kStairsAhead), 0) << ::testing::PrintToString(toks(s));
+  EXPECT_TRUE(p.camera_lost(3.0).empty());
+  EXPECT_TRUE(p.camera_back(3.1).empty());
+  s = feed(p, approach(8.0, StairKind::kDescending, 2.0f, 1.8));
+  EXPECT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
+  EXPECT_GE(count_of(s, Cue::kApproach), 1) << "the approach beep sounds through the mute";
+  // Between frames: nothing before the time, "unmuted" at it.
+  EXPECT_TRUE(p.between_frames(19.9, {}).empty());
+  const auto end = p.between_frames(20.0, {});
+  ASSERT_EQ(end.size(), 1u);
+  EXPECT_EQ(token(end[0]), "unmuted");
+  EXPECT_FALSE(haptic_pattern(end[0]).empty());
+  EXPECT_FALSE(p.muted());
+  // A long press while muted unmutes.
+  feed(p, {pressed(floor_frame(21.0), Press::kLong)});
+  EXPECT_TRUE(p.muted());
+  s = feed(p, {pressed(floor_frame(22.0), Press::kLong)});
+  EXPECT_EQ(toks(s), (std::vector<std::string>{"unmuted"}));
+  EXPECT_FALSE(p.muted());
+}
+
+// The mute ends on its time on a frame too, and a battery cue during it is held back.
+TEST(FeedbackButton, MuteEndsOnItsTimeOnAFrame) {
+  FeedbackConfig c;
+  c.mute = 10.f;
+  CuePolicy p{c};
+  feed(p, {pressed(floor_frame(0.0), Press::kLong)});
+  EXPECT_TRUE(p.battery(5.0, true, 0.10f, false).empty());
+  EXPECT_TRUE(feed(p, {floor_frame(9.9)}).empty());
+  EXPECT_EQ(toks(feed(p, {floor_frame(10.0)})), (std::vector<std::string>{"unmuted"}));
+}
+
+// A double press cycles quiet -> normal -> verbose -> quiet, said at every verbosity, and the new
+// verbosity holds (quiet: stairs ahead as an earcon); a reload that leaves the key as it was keeps it.
+TEST(FeedbackButton, DoublePressCyclesTheVerbosity) {
+  CuePolicy p{FeedbackConfig{}};
+  std::vector<std::string> said;
+  for (int i = 0; i < 3; ++i)
+    for (const auto& x : feed(p, {pressed(floor_frame(i * 1.0), Press::kDouble)}))
+      if (x.e.cue == Cue::kVerbosity) said.push_back(token(x.e) + "=" + clips_for(x.e).front());
+  EXPECT_EQ(said, (std::vector<std::string>{"verbosity_verbose=verbose", "verbosity_quiet=quiet",
+                                            "verbosity_normal=normal"}));
+  feed(p, {pressed(floor_frame(4.0), Press::kDouble), pressed(floor_frame(4.5), Press::kDouble)});
+  EXPECT_EQ(p.verbosity(), Verbosity::kQuiet);
+  p.reconfigure(FeedbackConfig{});  // verbosity "normal" as before: the button's choice stays
+  EXPECT_EQ(p.verbosity(), Verbosity::kQuiet);
+  const auto s = feed(p, approach(5.0, StairKind::kAscending, 3.5f, 1.0));
+  ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1);
+  for (const auto& x : s)
+    if (x.e.cue == Cue::kStairsAhead) {
+      EXPECT_TRUE(x.e.earcon_only);
+    }
+  FeedbackConfig v;
+  v.verbosity = "verbose";
+  p.reconfigure(v);
+  EXPECT_EQ(p.verbosity(), Verbosity::kVerbose);
+}
+
+// Every clip a cue can name is in the list the sink loads (and tools/make-sounds makes).
+TEST(FeedbackButton, AnswersUseKnownClips) {
+  const auto& all = all_clip_names();
+  auto known = [&](const std::string& n) { return std::find(all.begin(), all.end(), n) != all.end(); };
+  for (Cue c : {Cue::kWhere, Cue::kMuted, Cue::kUnmuted, Cue::kVerbosity})
+    for (int number : {-1, 0, 1, 2, 4})
+      for (StairKind k : {StairKind::kNone, StairKind::kAscending, StairKind::kCurb, StairKind::kSingleStep}) {
+        CueEvent e;
+        e.cue = c;
+        e.number = number;
+        e.kind = k;
+        e.clock = 3;
+        for (const auto& clip : clips_for(e)) EXPECT_TRUE(known(clip)) << token(e) << ": " << clip;
+        EXPECT_FALSE(clips_for(e).empty()) << token(e);
+      }
 }

@@ -29,7 +29,7 @@ using namespace stairguide;
 constexpr const char* kUsage =
     "usage: stairguided [--config FILE] [--replay FILE.oni|DIR|synth:SCENE[:FRAMES[:SEED[:NOISE]]]]\n"
     "                   [--realtime|--fast] [--sync] [--frames N] [--no-frame-lines]\n"
-    "                   [--audio DEVICE] [--no-haptic]\n"
+    "                   [--audio DEVICE] [--no-haptic] [--perception-delay S]\n"
     "       stairguided --check-config FILE\n"
     "\n"
     "Runs the stair guidance pipeline on the live camera (default) or on a recording.\n"
@@ -42,6 +42,8 @@ constexpr const char* kUsage =
     "  --no-frame-lines    no per-frame lines on stdout\n"
     "  --audio DEVICE      play the cues on ALSA PCM DEVICE (overrides feedback.audio_device)\n"
     "  --no-haptic         no buzzer (overrides feedback.haptic_enabled)\n"
+    "  --perception-delay S  (tests) hold each frame S seconds before perception: a machine\n"
+    "                      too slow for the camera, so that \"system slow\" is told\n"
     "  --check-config FILE validate FILE and exit (0 when valid)\n"
     "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the config file.\n";
 
@@ -55,6 +57,7 @@ struct Args {
   long frames = -1;
   std::string audio;  // --audio DEVICE, empty: the config's
   bool no_haptic = false;
+  double perception_delay = 0.0;  // s, --perception-delay
 };
 
 /// The command line's feedback overrides, applied to the config at start and to every reload.
@@ -107,6 +110,15 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
       a.frames = std::strtol(v.c_str(), &end, 10);
       if (v.empty() || *end || a.frames < 1) {
         err = "--frames expects a positive whole number, got '" + v + "'";
+        return false;
+      }
+    } else if (s == "--perception-delay") {
+      std::string v;
+      if (!value(v)) return false;
+      char* end = nullptr;
+      a.perception_delay = std::strtod(v.c_str(), &end);
+      if (*end || !(a.perception_delay >= 0.0 && a.perception_delay <= 10.0)) {
+        err = "--perception-delay expects seconds in [0, 10], got '" + v + "'";
         return false;
       }
     } else if (s == "--help" || s == "-h") {
@@ -228,6 +240,11 @@ int daemon_main(int argc, char** argv) {
   opt.synchronous = args.sync;
   opt.frame_lines = replay && args.frame_lines;
   opt.max_frames = args.frames;
+  opt.perception_delay_s = args.perception_delay;
+  if (opt.perception_delay_s > 0.0)
+    spdlog::warn("--perception-delay {:.3f} s: each frame is held that long before perception (a test of a slow "
+                 "machine)",
+                 opt.perception_delay_s);
 
   runtime::SystemdNotifier notifier;
   runtime::Runtime rt(config, opt, &notifier);

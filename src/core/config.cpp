@@ -1,5 +1,6 @@
 #include "stairguide/core/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <string>
@@ -117,6 +118,23 @@ std::vector<ConfigInconsistency> find_inconsistencies(const PipelineConfig& c) {
         "feedback.approach_interval_far_s");
   order(c.feedback.battery_critical, c.feedback.battery_low, "feedback.battery_critical_percent",
         "feedback.battery_low_percent");
+  // The button: a bounce shorter than the gap of a double press, and not the buzzer's own line.
+  if (!(c.feedback.button_debounce < c.feedback.button_double_press))
+    out.push_back({"feedback.button_debounce_s", "feedback.button_double_press_s",
+                   "feedback.button_debounce_s must be below feedback.button_double_press_s"});
+  if (c.feedback.button_enabled && c.feedback.haptic_enabled && c.feedback.button_chip == c.feedback.gpio_chip &&
+      c.feedback.button_line == c.feedback.gpio_line && c.feedback.button_chip.rfind("file:", 0) != 0)
+    out.push_back({"feedback.gpio_line", "feedback.button_line",
+                   "feedback.button_line is the buzzer's line (feedback.gpio_chip, feedback.gpio_line): one line "
+                   "cannot be both"});
+  // The language names a folder under sounds_dir: a plain name ("es", "pt-br"), never a path.
+  const std::string& lang = c.feedback.language;
+  const bool lang_ok = !lang.empty() && lang.size() <= 16 && std::all_of(lang.begin(), lang.end(), [](char ch) {
+    return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '-' || ch == '_';
+  });
+  if (!lang_ok)
+    out.push_back({"feedback.language", "feedback.language",
+                   "feedback.language '" + lang + "' is not a language name (lower-case letters, digits, '-': en, es, de, fr)"});
   if (c.feedback.approach_range > 0.f && !(c.feedback.approach_near < c.feedback.approach_range))
     out.push_back({"feedback.approach_near_m", "feedback.approach_range_m",
                    "feedback.approach_near_m must be below feedback.approach_range_m (or the range 0: off)"});

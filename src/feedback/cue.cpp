@@ -48,6 +48,14 @@ const char* to_string(Cue c) {
       return "battery_critical";
     case Cue::kSlow:
       return "slow";
+    case Cue::kWhere:
+      return "where";
+    case Cue::kMuted:
+      return "muted";
+    case Cue::kUnmuted:
+      return "unmuted";
+    case Cue::kVerbosity:
+      return "verbosity";
   }
   return "?";
 }
@@ -85,6 +93,11 @@ int cue_priority(Cue c) {
       return 4;
     case Cue::kApproach:
     case Cue::kSlow:
+    // The answers to a press: the wearer asked, and waits for them.
+    case Cue::kWhere:
+    case Cue::kMuted:
+    case Cue::kUnmuted:
+    case Cue::kVerbosity:
       return 5;
     case Cue::kBatteryLow:
       return 3;
@@ -131,8 +144,19 @@ std::string token(const CueEvent& e) {
     }
     return s;
   }
-  if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning) {
+  if (e.cue == Cue::kWhere && e.kind == StairKind::kNone && e.clock == 0) {
+    if (e.number >= 0) return s + ":" + std::to_string(e.number) + "_left";  // on a flight
+    return s + "_none";
+  }
+  if (e.cue == Cue::kVerbosity) {
+    static const char* level[] = {"_quiet", "_normal", "_verbose"};
+    return s + level[std::clamp(e.number, 0, 2)];
+  }
+  if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning ||
+      e.cue == Cue::kWhere) {
     if (e.cue == Cue::kStepAhead) s = e.kind == StairKind::kCurb ? "curb" : "step";
+    if (e.cue == Cue::kWhere)
+      s += e.kind == StairKind::kCurb ? "_curb" : e.kind == StairKind::kSingleStep ? "_step" : "";
     s += e.direction > 0 ? "_up" : "_down";
     if (e.number >= 0) s += ":" + std::to_string(e.number) + "m";
     if (e.clock > 0) s += "@" + std::to_string(e.clock);
@@ -151,7 +175,79 @@ std::string tokens(const std::vector<CueEvent>& events) {
   return s;
 }
 
+namespace {
+// The answer to "where are the stairs?": what is ahead with its distance and clock position (said
+// even at 12: the wearer asked where), the steps left on a flight, or "no stairs".
+std::vector<std::string> where_clips(const CueEvent& e) {
+  const bool up = e.direction > 0;
+  std::vector<std::string> c;
+  switch (e.kind) {
+    case StairKind::kAscending:
+    case StairKind::kDescending:
+      c = {up ? "stairs_up" : "stairs_down"};
+      break;
+    case StairKind::kSingleStep:
+      c = {up ? "step_up" : "step_down"};
+      break;
+    case StairKind::kCurb:
+      c = {up ? "curb_up" : "curb_down"};
+      break;
+    default:
+      if (sayable(e.number)) return {number_clip(e.number), "steps_left"};
+      return {"no_stairs"};
+  }
+  if (sayable(e.number)) {
+    c.push_back(number_clip(e.number));
+    c.push_back(e.number == 1 ? "metre" : "metres");
+  }
+  if (e.clock >= 1 && e.clock <= 12) {
+    c.push_back(number_clip(e.clock));
+    c.push_back("oclock");
+  }
+  return c;
+}
+}  // namespace
+
+namespace {
+// The clip of a cue said by one clip of its own whatever it carries; nullptr for the others.
+const char* own_clip(Cue c) {
+  switch (c) {
+    case Cue::kReady:
+      return "ready";
+    case Cue::kCameraLost:
+      return "camera_lost";
+    case Cue::kCameraBack:
+      return "camera_back";
+    case Cue::kBlind:
+      return "cannot_see";
+    case Cue::kFirstStep:
+      return "first_step";
+    case Cue::kTick:
+      return "tick";
+    case Cue::kLastStep:
+      return "last_step";
+    case Cue::kEndOfStairs:
+      return "end_of_stairs";
+    case Cue::kApproach:
+      return "approach";
+    case Cue::kBatteryLow:
+      return "battery_low";
+    case Cue::kBatteryCritical:
+      return "battery_critical";
+    case Cue::kSlow:
+      return "slow";
+    case Cue::kMuted:
+      return "muted";
+    case Cue::kUnmuted:
+      return "unmuted";
+    default:
+      return nullptr;
+  }
+}
+}  // namespace
+
 std::vector<std::string> clips_for(const CueEvent& e) {
+  if (const char* own = own_clip(e.cue)) return {own};
   std::vector<std::string> c;
   const bool up = e.direction > 0;
   auto distance = [&] {
@@ -165,18 +261,6 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     }
   };
   switch (e.cue) {
-    case Cue::kReady:
-      c = {"ready"};
-      break;
-    case Cue::kCameraLost:
-      c = {"camera_lost"};
-      break;
-    case Cue::kCameraBack:
-      c = {"camera_back"};
-      break;
-    case Cue::kBlind:
-      c = {"cannot_see"};
-      break;
     case Cue::kStairsAhead:
       if (e.earcon_only) {
         c = {up ? "up" : "down"};
@@ -197,12 +281,6 @@ std::vector<std::string> clips_for(const CueEvent& e) {
       else
         c = {up ? "step_up" : "step_down"};
       break;
-    case Cue::kFirstStep:
-      c = {"first_step"};
-      break;
-    case Cue::kTick:
-      c = {"tick"};
-      break;
     case Cue::kCount:
       if (sayable(e.number))
         c = {number_clip(e.number)};
@@ -212,23 +290,13 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kStepsLeft:
       if (sayable(e.number)) c = {number_clip(e.number), "steps_left"};
       break;
-    case Cue::kLastStep:
-      c = {"last_step"};
+    case Cue::kWhere:
+      c = where_clips(e);
       break;
-    case Cue::kEndOfStairs:
-      c = {"end_of_stairs"};
+    case Cue::kVerbosity:
+      c = {e.number <= 0 ? "quiet" : e.number == 1 ? "normal" : "verbose"};
       break;
-    case Cue::kApproach:
-      c = {"approach"};
-      break;
-    case Cue::kBatteryLow:
-      c = {"battery_low"};
-      break;
-    case Cue::kBatteryCritical:
-      c = {"battery_critical"};
-      break;
-    case Cue::kSlow:
-      c = {"slow"};
+    default:  // own_clip's
       break;
   }
   return c;
@@ -240,11 +308,16 @@ const std::vector<std::string>& all_clip_names() {
         "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
         "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
-        "approach", "battery_low", "battery_critical", "slow"};
+        "approach", "battery_low", "battery_critical", "slow",
+        "no_stairs", "muted", "unmuted", "quiet", "normal", "verbose"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();
   return names;
+}
+
+bool is_earcon_clip(const std::string& name) {
+  return name == "tick" || name == "approach" || name == "up" || name == "down" || name == "warning";
 }
 
 }  // namespace stairguide::feedback

@@ -25,14 +25,14 @@ int clock_position(float bearing_rad) {
   return c == 0 ? 12 : c;
 }
 
-CuePolicy::CuePolicy(const FeedbackConfig& config) {
+CuePolicy::CuePolicy(const FeedbackConfig& config) : cfg_(config), verbosity_(parse_verbosity(config.verbosity)) {
   std::fill(std::begin(last_t_), std::end(last_t_), kNever);
-  reconfigure(config);
 }
 
 void CuePolicy::reconfigure(const FeedbackConfig& config) {
+  // The verbosity the button chose is kept unless the reload changes the key itself.
+  if (config.verbosity != cfg_.verbosity) verbosity_ = parse_verbosity(config.verbosity);
   cfg_ = config;
-  verbosity_ = parse_verbosity(config.verbosity);
 }
 
 int CuePolicy::key_of(StairKind kind, int direction) {
@@ -55,6 +55,10 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kLastStep:
     case Cue::kStairsAhead:  // as an earcon
     case Cue::kStepAhead:
+    case Cue::kWhere:  // the answers to the button
+    case Cue::kMuted:
+    case Cue::kUnmuted:
+    case Cue::kVerbosity:
       return true;
     default:
       return false;
@@ -73,6 +77,10 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kBatteryLow:  // their own repeats (battery(), step())
     case Cue::kBatteryCritical:
     case Cue::kSlow:
+    case Cue::kWhere:  // asked for
+    case Cue::kMuted:
+    case Cue::kUnmuted:
+    case Cue::kVerbosity:
       return true;
     case Cue::kTick:
       return t - last >= cfg_.min_tick_interval;
@@ -298,6 +306,7 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     blind_since_ = -1.0;
     slow_since_ = -1.0;
     approach_ = Approach{};
+    if (mute_until_ >= 0.0) mute_until_ = t + std::max(0.0, mute_until_ - last_frame_t_);  // what was left of it
   }
   last_frame_t_ = t;
   if (!ready_told_) {
@@ -316,6 +325,11 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
   }
   if (s.present && s.kind == StairKind::kNone) s.present = false;
   detection_cues(s, t, out);
+  if (s.present && told_.active && key_of(s.kind, s.direction) == told_.key) held_ = s;
+  if (tr.ran) {
+    flight_left_ = tr.steps_left;
+    flight_dir_ = tr.direction;
+  }
   approach_cues(s, tr, t, out);
   if (tr.ran) flight_cues(tr, t, out);
   blind_cues(in, t, out);
@@ -331,8 +345,102 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     slow_since_ = -1.0;
     last_t_[static_cast<int>(Cue::kSlow)] = kNever;  // over: the next fall behind is told at once
   }
+  button_cues(in.presses, t, out);
+  mute_filter(out, t);
+  by_priority(out);
+  return out;
+}
+
+void CuePolicy::by_priority(std::vector<CueEvent>& out) {
   std::stable_sort(out.begin(), out.end(),
                    [](const CueEvent& a, const CueEvent& b) { return a.priority > b.priority; });
+}
+
+// ---------------------------------------------------------------- the button
+
+void CuePolicy::mute_filter(std::vector<CueEvent>& out, double t) {
+  if (mute_until_ < 0.0) return;
+  if (t >= mute_until_) {  // its time is up: told, and nothing of this moment is held back
+    mute_until_ = -1.0;
+    CueEvent e;
+    e.cue = Cue::kUnmuted;
+    emit(out, e, t);
+    return;
+  }
+  // A descent's warnings are never muted (the wearer may be walking towards the edge), nor the
+  // answers to the button (asked for).
+  out.erase(std::remove_if(out.begin(), out.end(),
+                           [](const CueEvent& e) {
+                             switch (e.cue) {
+                               case Cue::kDropWarning:
+                               case Cue::kApproach:
+                               case Cue::kWhere:
+                               case Cue::kMuted:
+                               case Cue::kUnmuted:
+                               case Cue::kVerbosity:
+                                 return false;
+                               default:
+                                 return true;
+                             }
+                           }),
+            out.end());
+}
+
+CueEvent CuePolicy::where_event(double t) const {
+  CueEvent e;
+  e.cue = Cue::kWhere;
+  if (on_flight(prev_state_)) {  // the staircase is under the feet: how much of it is left
+    e.direction = flight_dir_ < 0 ? -1 : 1;
+    if (flight_left_ >= 1)
+      e.number = flight_left_;
+    else  // not known yet: which way the stairs go on
+      e.kind = e.direction > 0 ? StairKind::kAscending : StairKind::kDescending;
+    return e;
+  }
+  const bool held = told_.active && t - told_.last_seen_t <= cfg_.forget_time && held_.present;
+  if (!held) return e;  // "no stairs"
+  e.kind = held_.kind;
+  e.direction = key_of(held_.kind, held_.direction) > 0 ? 1 : -1;
+  e.number = metres_of(held_.distance_m);
+  e.clock = clock_position(held_.bearing_rad);
+  e.bearing_rad = held_.bearing_rad;
+  return e;
+}
+
+void CuePolicy::button_cues(const std::vector<Press>& presses, double t, std::vector<CueEvent>& out) {
+  for (const Press p : presses) {
+    CueEvent e;
+    switch (p) {
+      case Press::kShort:
+        e = where_event(t);
+        break;
+      case Press::kLong:
+        if (mute_until_ >= 0.0) {
+          mute_until_ = -1.0;
+          e.cue = Cue::kUnmuted;
+        } else {
+          mute_until_ = t + cfg_.mute;
+          e.cue = Cue::kMuted;
+          e.number = static_cast<int>(std::lround(cfg_.mute));
+        }
+        break;
+      case Press::kDouble:
+        verbosity_ = verbosity_ == Verbosity::kQuiet    ? Verbosity::kNormal
+                     : verbosity_ == Verbosity::kNormal ? Verbosity::kVerbose
+                                                        : Verbosity::kQuiet;
+        e.cue = Cue::kVerbosity;
+        e.number = static_cast<int>(verbosity_);
+        break;
+    }
+    emit(out, e, t);
+  }
+}
+
+std::vector<CueEvent> CuePolicy::between_frames(double t, const std::vector<Press>& presses) {
+  std::vector<CueEvent> out;
+  button_cues(presses, t, out);
+  mute_filter(out, t);
+  by_priority(out);
   return out;
 }
 
@@ -353,6 +461,7 @@ std::vector<CueEvent> CuePolicy::battery(double t, bool present, float charge, b
     emit(out, e, t);
     battery_told_ = std::max(battery_told_, level);
   }
+  mute_filter(out, t);
   return out;
 }
 
@@ -364,6 +473,7 @@ std::vector<CueEvent> CuePolicy::camera_lost(double t) {
   CueEvent e;
   e.cue = Cue::kCameraLost;
   emit(out, e, t);
+  mute_filter(out, t);
   return out;
 }
 
@@ -374,6 +484,7 @@ std::vector<CueEvent> CuePolicy::camera_back(double t) {
   CueEvent e;
   e.cue = Cue::kCameraBack;
   emit(out, e, t);
+  mute_filter(out, t);
   return out;
 }
 

@@ -40,7 +40,13 @@ HapticPattern haptic_pattern(const CueEvent& e) {
     case Cue::kBatteryCritical:
       return {{200, 100}, {200, 100}, {200, 100}, {200, 0}};
     case Cue::kSlow:
+    case Cue::kWhere:
+    case Cue::kVerbosity:
       return {};  // spoken only
+    case Cue::kMuted:
+      return {{40, 60}, {40, 60}, {40, 60}, {40, 0}};  // a flutter: sound off
+    case Cue::kUnmuted:
+      return {{150, 0}};  // as ready: sound on again
   }
   return {};
 }

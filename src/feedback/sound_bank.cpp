@@ -1,5 +1,7 @@
 #include "stairguide/feedback/sound_bank.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -64,6 +66,20 @@ bool read_wav(const std::string& path, std::vector<std::int16_t>& samples, int& 
   }
   why = have_fmt ? "no data chunk" : "no fmt chunk";
   return false;
+}
+
+SoundSet sound_set_for(const std::string& sounds_dir, const std::string& language) {
+  SoundSet set{sounds_dir, sounds_dir, "en", ""};
+  if (language.empty() || language == "en") return set;
+  const std::string dir = sounds_dir + "/" + language;
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    set.speech_dir = dir;
+    set.language = language;
+  } else {
+    set.problem = "no sounds for language '" + language + "' (feedback.language): " + dir + " is not a folder";
+  }
+  return set;
 }
 
 SoundBank load_sound_bank(const std::string& dir, const std::vector<std::string>& names, float volume) {

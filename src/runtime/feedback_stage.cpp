@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "stairguide/feedback/audio_sink.hpp"
+#include "stairguide/feedback/button.hpp"
 #include "stairguide/feedback/cue_policy.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/power_supply.hpp"
@@ -61,8 +62,57 @@ struct FeedbackStage::Impl {
   std::uint64_t next_id = 1;
   SteadyClock::time_point next_battery_poll{};  // the first frame reads it
   bool battery_seen = false;
+  // The wearer's button: read on a thread of its own, opened on the first poll or frame.
+  std::unique_ptr<fb::ButtonReader> button;
+  bool button_tried = false;
+  SteadyClock::time_point last_decide = SteadyClock::now();  // the frames' clock is carried on from it
 
   explicit Impl(const PipelineConfig& c) : config(c), policy(c.feedback) {}
+
+  void open_button() {
+    if (button_tried) return;
+    button_tried = true;
+    const FeedbackConfig& f = config.feedback;
+    if (!f.button_enabled) return;
+    auto warn = [](const std::string& s) { spdlog::warn("{}", s); };
+    try {
+      fb::PressTiming tm{f.button_debounce, f.button_long_press, f.button_double_press};
+      button = std::make_unique<fb::ButtonReader>(
+          fb::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
+      spdlog::info("button: reading presses on {} (short: where are the stairs; long: mute {:.0f} s; double: "
+                   "verbosity)",
+                   button->describe(), f.mute);
+    } catch (const std::exception& e) {
+      spdlog::error("{}; going on without the button (feedback.button_enabled: false silences this)", e.what());
+    }
+  }
+
+  /// The presses since the last look, logged.
+  std::vector<fb::Press> take_presses() {
+    open_button();
+    std::vector<fb::Press> out;
+    if (!button) return out;
+    for (const fb::PressEvent& p : button->take()) {
+      spdlog::info("button: {} press", fb::to_string(p.press));
+      out.push_back(p.press);
+    }
+    return out;
+  }
+
+  /// Loads the clips of the configured language (English, logged, when it is missing).
+  fb::SoundBank load_sounds(const FeedbackConfig& f) {
+    const fb::SoundSet set = fb::sound_set_for(f.sounds_dir, f.language);
+    if (!set.problem.empty()) spdlog::error("audio: {}; speaking English from {}", set.problem, f.sounds_dir);
+    std::vector<std::string> words, earcons;
+    for (const auto& n : fb::all_clip_names()) (fb::is_earcon_clip(n) ? earcons : words).push_back(n);
+    fb::SoundBank bank = fb::load_sound_bank(set.speech_dir, words, f.volume);
+    fb::SoundBank shared = fb::load_sound_bank(set.earcon_dir, earcons, f.volume);
+    bank.clips.insert(shared.clips.begin(), shared.clips.end());
+    bank.problems.insert(bank.problems.end(), shared.problems.begin(), shared.problems.end());
+    if (!bank.clips.empty())
+      spdlog::info("audio: cues in {} ({}), earcons from {}", set.language, set.speech_dir, set.earcon_dir);
+    return bank;
+  }
 
   void open_sinks() {
     if (sinks_open) return;
@@ -70,7 +120,7 @@ struct FeedbackStage::Impl {
     const FeedbackConfig& f = config.feedback;
     fb::SoundBank bank;
     if (f.audio_enabled) {
-      bank = fb::load_sound_bank(f.sounds_dir, fb::all_clip_names(), f.volume);
+      bank = load_sounds(f);
       if (bank.clips.empty())
         spdlog::error(
             "audio: no usable sound in '{}' (feedback.sounds_dir; {}): cues are silent, the buzzer "
@@ -246,9 +296,11 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   d.changed = d.state != impl_->last_state;
   impl_->last_state = d.state;
   impl_->last_t = timestamp_s;
+  impl_->last_decide = SteadyClock::now();
   impl_->check_lost();
   if (!perception.ran) return d;  // no perception stage: nothing to tell
   fb::CueInput in;
+  in.presses = impl_->take_presses();
   in.t = timestamp_s;
   in.floor_found = perception.floor_found;
   in.stair = perception.stair;
@@ -276,6 +328,16 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   return d;
 }
 
+void FeedbackStage::poll() {
+  Impl& m = *impl_;
+  const std::vector<fb::Press> presses = m.take_presses();
+  if (presses.empty() && !m.policy.muted()) return;
+  // The frames' clock carried on by the steady clock since the last frame.
+  const double t = m.last_t + std::chrono::duration<double>(SteadyClock::now() - m.last_decide).count();
+  const auto c = m.deliver(m.policy.between_frames(t, presses), SteadyClock::now());
+  if (!c.empty()) spdlog::info("cue {} (button)", c);
+}
+
 void FeedbackStage::camera_lost(const std::string& why) {
   const auto c = impl_->deliver(impl_->policy.camera_lost(impl_->last_t), SteadyClock::now());
   if (!c.empty()) spdlog::info("cue {} ({})", c, why);
@@ -292,8 +354,11 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
   if (impl_->sinks_open &&
       (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
        a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled || a.stereo_pan != b.stereo_pan ||
-       a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line))
-    spdlog::info("feedback: sound device, sounds and buzzer settings apply at the next start");
+       a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line || a.language != b.language ||
+       a.button_enabled != b.button_enabled || a.button_chip != b.button_chip || a.button_line != b.button_line ||
+       a.button_active_low != b.button_active_low || a.button_debounce != b.button_debounce ||
+       a.button_long_press != b.button_long_press || a.button_double_press != b.button_double_press))
+    spdlog::info("feedback: sound device, sounds, language, buzzer and button settings apply at the next start");
   PipelineConfig keep = config;
   const FeedbackConfig old = impl_->config.feedback;
   keep.feedback = b;
@@ -307,6 +372,16 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
     keep.feedback.haptic_enabled = old.haptic_enabled;
     keep.feedback.gpio_chip = old.gpio_chip;
     keep.feedback.gpio_line = old.gpio_line;
+    keep.feedback.language = old.language;
+  }
+  if (impl_->button_tried) {
+    keep.feedback.button_enabled = old.button_enabled;
+    keep.feedback.button_chip = old.button_chip;
+    keep.feedback.button_line = old.button_line;
+    keep.feedback.button_active_low = old.button_active_low;
+    keep.feedback.button_debounce = old.button_debounce;
+    keep.feedback.button_long_press = old.button_long_press;
+    keep.feedback.button_double_press = old.button_double_press;
   }
   impl_->config = keep;
   impl_->policy.reconfigure(keep.feedback);

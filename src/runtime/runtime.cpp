@@ -585,6 +585,10 @@ struct Runtime::Impl {
 
   PercMsg run_perception(const FramePacket& p, std::uint64_t gen) {
     PercMsg m;
+    // A machine too slow for the camera, played (RuntimeOptions::perception_delay_s): the stage is
+    // held before it runs, as a busy CPU would hold it.
+    if (opt.perception_delay_s > 0.0)
+      std::this_thread::sleep_for(std::chrono::duration<double>(opt.perception_delay_s));
     m.out = perception->step(*p.frame, p.seq, [this](std::uint64_t seq, OdometryLink& link, bool wait) {
       return odometry_pose_of(seq, link, wait);
     });
@@ -858,6 +862,7 @@ struct Runtime::Impl {
       if (got) sink_space.ring();
       emit_lines(perc_taken, odo_finished, perc_finished);
       handle_camera_events();
+      feedback->poll();  // the wearer's button, answered whether frames come or not
       maybe_report();
       if (stop.load()) break;
       if (odo_finished && perc_finished && odo_out->empty() && perc_out->empty()) {
@@ -1106,6 +1111,7 @@ void Runtime::Impl::run_synchronous(std::uint64_t& gen) {
                       m.perception->last_scene(), m.perception->last_stair(), m.perc_pending.back().cue});
     m.emit_lines(p.seq + 1, false, false);
     m.handle_camera_events();
+    m.feedback->poll();
     m.beat(kOdometry);
     m.beat(kSink);
     m.maybe_watchdog();

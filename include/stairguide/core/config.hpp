@@ -505,6 +505,15 @@ struct FeedbackConfig {
   float slow_lag = 0.5f;                  ///< s from capture to decision beyond which perception is behind
   float slow_after = 3.0f;                ///< s behind before "slow" is said
   float slow_repeat = 60.0f;              ///< s between two "slow" while it lasts
+  bool button_enabled = false;            ///< read the wearer's push button
+  std::string button_chip = "gpiochip0";  ///< name or /dev path; "file:PATH" reads presses from PATH (tests)
+  int button_line = 27;                   ///< GPIO line offset of the button
+  bool button_active_low = true;          ///< pressed when the line is low (a button to ground, pulled up)
+  float button_debounce = 0.03f;          ///< s a level must hold to count (contact bounce is shorter)
+  float button_long_press = 1.0f;         ///< s held: a long press (mute)
+  float button_double_press = 0.4f;       ///< s from a release to the next press: a double press
+  float mute = 300.0f;                    ///< s a long press mutes the cues (a descent's warnings still sound)
+  std::string language = "en";            ///< the cues' language: sounds_dir/<language>/ ("en": sounds_dir itself)
 
   template <class V> void visit(V& v) {
     v.flag(audio_enabled, "audio_enabled", "play audio cues");
@@ -545,6 +554,15 @@ struct FeedbackConfig {
     v.num(slow_lag, "slow_lag_s", Unit::kSecond, 0.05, 10, "capture to decision longer than this: perception is behind the camera");
     v.num(slow_after, "slow_after_s", Unit::kSecond, 0.1, 600, "behind this long: say slow");
     v.num(slow_repeat, "slow_repeat_s", Unit::kSecond, 1, 3600, "say slow again at this interval while it lasts");
+    v.flag(button_enabled, "button_enabled", "read the wearer's push button (short: where are the stairs; long: mute; double: verbosity)");
+    v.text(button_chip, "button_chip", {}, "GPIO chip of the button (name or /dev path; file:PATH reads '<seconds> down|up' lines)");
+    v.num(button_line, "button_line", Unit::kCount, 0, 1023, "GPIO line offset of the button");
+    v.flag(button_active_low, "button_active_low", "pressed when the line is low (a button to ground, the line pulled up)");
+    v.num(button_debounce, "button_debounce_s", Unit::kSecond, 0.001, 0.2, "a level must hold this long to count (contact bounce)");
+    v.num(button_long_press, "button_long_press_s", Unit::kSecond, 0.3, 5, "held this long: a long press (mute)");
+    v.num(button_double_press, "button_double_press_s", Unit::kSecond, 0.1, 2, "pressed again within this of a release: a double press (verbosity)");
+    v.num(mute, "mute_s", Unit::kSecond, 1, 7200, "a long press mutes the cues this long (a descending staircase still warns)");
+    v.text(language, "language", {}, "language of the spoken cues: sounds_dir/<language>/ (en, es, de, fr; en: sounds_dir itself)");
   }
 };
 

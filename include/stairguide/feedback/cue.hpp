@@ -31,10 +31,17 @@ enum class Cue {
   kBatteryLow,       ///< the laptop's battery is low (`number`: percent), not charging
   kBatteryCritical,  ///< ... critically low: the daemon will soon stop
   kSlow,             ///< perception has fallen behind the camera for long enough to matter
+  // Answers to the wearer's button (button.hpp):
+  kWhere,      ///< short press: the nearest known staircase (`kind`, `direction`, `number` metres,
+               ///< `clock`), steps left on a flight (`number`; not known: the flight's `kind`
+               ///< and `direction`), or none known (`kind` kNone, `number` -1)
+  kMuted,      ///< long press: the cues are muted for `number` s (a descent still warns)
+  kUnmuted,    ///< the mute is over (its time, or another long press)
+  kVerbosity,  ///< double press: the verbosity is now `number` (0 quiet, 1 normal, 2 verbose)
 };
 
 /// Number of Cue values (for tables indexed by cue).
-constexpr int kCueKinds = static_cast<int>(Cue::kSlow) + 1;
+constexpr int kCueKinds = static_cast<int>(Cue::kVerbosity) + 1;
 
 /// Whether the cue marks a step of a flight (first step, tick, count, steps left, last step, end
 /// of stairs): its moment passes with the next step, after which it must not be heard.
@@ -42,7 +49,7 @@ bool marks_a_step(Cue c);
 
 /// "ready", "camera_lost", "camera_back", "blind", "stairs_ahead", "drop_warning", "step_ahead",
 /// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs", "approach",
-/// "battery_low", "battery_critical", "slow".
+/// "battery_low", "battery_critical", "slow", "where", "muted", "unmuted", "verbosity".
 const char* to_string(Cue c);
 
 /// Higher interrupts lower: a warning cuts a tick. Fixed per cue (see cue.cpp for the order).
@@ -91,5 +98,7 @@ std::string tokens(const std::vector<CueEvent>& events);
 std::vector<std::string> clips_for(const CueEvent& e);
 /// Every clip the cues can use (what tools/make-sounds makes and the sink preloads).
 const std::vector<std::string>& all_clip_names();
+/// Of them, the earcons (no words: one set for every language, in sounds_dir itself).
+bool is_earcon_clip(const std::string& name);
 
 }  // namespace stairguide::feedback

@@ -31,6 +31,15 @@
 ///   perception has been more than `slow_lag` s behind the camera (`lag_s`) for `slow_after` s,
 ///   again every `slow_repeat` s while it lasts (over when the lag falls below half `slow_lag`).
 ///
+/// - The wearer's button (`presses`, or between_frames() when no frame comes): a short press is
+///   answered with where the staircase held in mind is (kWhere: kind, up or down, metres, clock
+///   position, said even at 12), the steps left on a flight (or which way it goes), or "no
+///   stairs"; a long press mutes every cue for `mute` s (kMuted; another long press or the
+///   time's end: kUnmuted), except what warns of a descent (the drop warning, the approach beep)
+///   and the answers to the button; a double press cycles the verbosity quiet -> normal ->
+///   verbose -> quiet (kVerbosity). What is muted is not told later (a short press asks). A
+///   reload that changes `verbosity` sets it again.
+///
 /// Verbosity: quiet = warnings (drop, last step, blind, camera) and earcons for stairs and steps
 /// ahead; normal = the words for what is ahead, first step, ticks, counts every `count_interval`
 /// steps, steps left once known, end of stairs; verbose = also the distance as it shrinks and
@@ -39,6 +48,7 @@
 #include <vector>
 
 #include "stairguide/core/config.hpp"
+#include "stairguide/feedback/button.hpp"
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/stairs/traversal_result.hpp"
 
@@ -55,6 +65,7 @@ struct CueInput {
   StairSummary stair;         ///< this frame's detection
   TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
   double lag_s = 0.0;         ///< s from the frame's capture to this decision (perception behind)
+  std::vector<Press> presses;  ///< the wearer's button presses since the last decision, in order
 };
 
 /// Clock position (1..12, 12 straight ahead, 3 to the right) of a bearing in rad; 12 for NaN.
@@ -76,6 +87,11 @@ class CuePolicy {
   /// "battery critical" at `battery_critical`, every `battery_critical_repeat` s. Charging, or a
   /// charge 3 points above the low mark, ends it (told again on the next fall).
   std::vector<CueEvent> battery(double t, bool present, float charge, bool charging);
+  /// Between two frames (none has come for a while: the camera is lost, perception is slow): the
+  /// button's `presses` at time `t` (on the frames' clock, carried on), and the end of a mute.
+  std::vector<CueEvent> between_frames(double t, const std::vector<Press>& presses);
+  bool muted() const { return mute_until_ >= 0.0; }
+  Verbosity verbosity() const { return verbosity_; }
 
  private:
   struct Sighting {
@@ -110,6 +126,10 @@ class CuePolicy {
   void blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out);
   void approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out);
   float approach_interval(float d) const;
+  void button_cues(const std::vector<Press>& presses, double t, std::vector<CueEvent>& out);
+  CueEvent where_event(double t) const;
+  void mute_filter(std::vector<CueEvent>& out, double t);
+  static void by_priority(std::vector<CueEvent>& out);
 
   FeedbackConfig cfg_;
   Verbosity verbosity_ = Verbosity::kNormal;
@@ -141,6 +161,11 @@ class CuePolicy {
   // System state.
   int battery_told_ = 0;  // 0 nothing, 1 low, 2 critical: the level told of this fall
   double slow_since_ = -1.0;
+  // The button.
+  double mute_until_ = -1.0;  // < 0: not muted
+  Sighting held_;             // the last sighting of the staircase held in mind (told_)
+  int flight_left_ = -1;      // the tracker's steps left and direction, as of the last frame
+  int flight_dir_ = 0;
 };
 
 }  // namespace stairguide::feedback

@@ -10,6 +10,7 @@
 ///   blind, camera lost: three long                    ready, camera back: one medium
 ///   approach (to a descent's edge): one sharp 40 ms pulse per beep, the beeps closer as it nears
 ///   battery low: two of 200 ms                         battery critical: four of 200 ms
+///   muted (a long press): four 40 ms taps               unmuted: one medium
 ///
 /// Lines: `GpiodLine` (libgpiod 1.6), `FileLine` (writes every edge to a file: the daemon's test
 /// backend, gpio_chip "file:PATH"), `RecordingLine` (a fake: edges with their times, in memory).

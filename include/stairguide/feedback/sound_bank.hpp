@@ -25,6 +25,19 @@ struct SoundBank {
   }
 };
 
+/// Where the clips of a language are: the spoken ones in `speech_dir`, the earcons (no words, one
+/// set for all) in `earcon_dir`.
+struct SoundSet {
+  std::string speech_dir, earcon_dir;
+  std::string language;  ///< the language spoken ("en" when the one asked for is missing)
+  std::string problem;   ///< why the language asked for is not spoken ("" when it is)
+};
+
+/// The set for `language` under `sounds_dir`: English is `sounds_dir` itself (where installs have
+/// always had it); another language is the folder `sounds_dir/<language>` when it exists, else
+/// English with `problem` naming the language and the folder looked for.
+SoundSet sound_set_for(const std::string& sounds_dir, const std::string& language);
+
 /// Loads `names` from `dir` (DIR/NAME.wav), scaled by `volume` (0..1). A clip that is missing,
 /// unreadable, or not 16-bit mono at kSoundRate is left out and named in `problems`.
 SoundBank load_sound_bank(const std::string& dir, const std::vector<std::string>& names, float volume);

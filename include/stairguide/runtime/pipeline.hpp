@@ -149,6 +149,10 @@ class FeedbackStage {
   Decision decide(const PerceptionOutput& perception, const OdometryOutput* latest_odometry,
                   double timestamp_s = 0.0,
                   std::chrono::steady_clock::time_point captured = std::chrono::steady_clock::now());
+  /// Between frames (the feedback thread's every turn, at least every 50 ms): the wearer's button
+  /// presses answered at once and a mute ended on time, even when no frame comes. Opens the
+  /// button (feedback.button_enabled) on its first call.
+  void poll();
   /// The camera stopped sending (`why` names it) / is back: the user must be told.
   void camera_lost(const std::string& why);
   void camera_back();

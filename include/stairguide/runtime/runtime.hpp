@@ -78,6 +78,9 @@ struct RuntimeOptions {
   /// Synchronous mode only: called on the calling thread once a frame has been through every
   /// stage and the feedback decision. An exception it throws ends run() and reaches its caller.
   std::function<void(const FrameObservation&)> observer;
+  /// s each frame is held before perception runs: plays a machine that cannot keep up with the
+  /// camera (perception falls behind, "slow" is told) in end-to-end tests. 0: none.
+  double perception_delay_s = 0.0;
   /// Starts worker thread `name` running `body` (empty: std::thread). A seam for tests of a
   /// thread that cannot be started; throws what std::thread throws.
   std::function<std::thread(const char* name, std::function<void()> body)> start_thread;

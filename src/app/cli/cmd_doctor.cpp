@@ -38,6 +38,7 @@
 #include "stairguide/config/config_loader.hpp"
 #include "stairguide/core/json.hpp"
 #include "stairguide/feedback/audio_sink.hpp"
+#include "stairguide/feedback/button.hpp"
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/sound_bank.hpp"
@@ -270,6 +271,29 @@ Check check_buzzer(const FeedbackConfig& cfg) {
   return c;
 }
 
+// ---- 4b. the wearer's button (only when the config asks for one) ------------------------------
+
+Check check_button(const FeedbackConfig& cfg) {
+  Check c{"button"};
+  const bool file = cfg.button_chip.rfind("file:", 0) == 0;  // a test button reading presses from a file
+  const std::string where = file ? "the button's presses file " + cfg.button_chip.substr(5) + " (a test button)"
+                                 : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
+  try {
+    const auto line = feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
+    c.message = where + (file ? " opened" : " requested for its edges") +
+                ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
+  } catch (const std::exception& e) {
+    c.status = Status::kFail;
+    std::string why = e.what();
+    if (why.rfind("button: ", 0) == 0) why.erase(0, 8);
+    c.message = "cannot use the button: " + why;
+    c.fix = "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.button_chip and "
+            "feedback.button_line to the button's (or feedback.button_enabled: false for none); the user must "
+            "be in group gpio";
+  }
+  return c;
+}
+
 // ---- 5. the service user ---------------------------------------------------------------------
 
 struct Identity {
@@ -438,16 +462,36 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
             "/usr/share/stairguide/sounds ('cmake --install' in PREFIX/share/stairguide/sounds)";
     return c;
   }
+  // The words of the configured language (feedback.language), the earcons from the folder itself.
+  const feedback::SoundSet set = feedback::sound_set_for(dir, cfg.language);
+  if (!set.problem.empty()) {
+    c.status = Status::kFail;
+    c.message = set.problem + ": the daemon speaks English instead";
+    c.fix = "set feedback.language to one of the folders under " + dir +
+            " (en: the folder itself), or make the set with tools/make-sounds --lang " + cfg.language;
+    return c;
+  }
   const auto& names = feedback::all_clip_names();
-  const feedback::SoundBank bank = feedback::load_sound_bank(dir, names, 1.0f);
-  std::vector<std::string> problems = bank.problems;
+  std::vector<std::pair<std::string, std::vector<std::string>>> folders;  // each folder, the clips it holds
+  if (set.speech_dir == set.earcon_dir) {
+    folders.push_back({dir, names});
+  } else {
+    folders.push_back({set.speech_dir, {}});
+    folders.push_back({set.earcon_dir, {}});
+    for (const auto& n : names) folders[feedback::is_earcon_clip(n) ? 1 : 0].second.push_back(n);
+  }
+  std::vector<std::string> problems;
   Identity id;
-  if (find_user(user, id)) {
+  const bool have_user = find_user(user, id);
+  for (const auto& [folder, these] : folders) {
+    const feedback::SoundBank bank = feedback::load_sound_bank(folder, these, 1.0f);
+    problems.insert(problems.end(), bank.problems.begin(), bank.problems.end());
+    if (!have_user) continue;
     struct stat st {};
-    if (stat(dir.c_str(), &st) == 0 && !may(id, st, 5))
-      problems.push_back("'" + user + "' cannot open the folder " + dir + " (" + owner_text(st) + ")");
-    for (const auto& n : names) {
-      const std::string p = dir + "/" + n + ".wav";
+    if (stat(folder.c_str(), &st) == 0 && !may(id, st, 5))
+      problems.push_back("'" + user + "' cannot open the folder " + folder + " (" + owner_text(st) + ")");
+    for (const auto& n : these) {
+      const std::string p = folder + "/" + n + ".wav";
       if (stat(p.c_str(), &st) == 0 && !may(id, st, 4))
         problems.push_back("'" + user + "' cannot read " + p + " (" + owner_text(st) + ")");
     }
@@ -462,7 +506,8 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
             "source tree's sounds/ into " + dir + " (16-bit mono, readable by everyone)";
     return c;
   }
-  c.message = "all " + std::to_string(names.size()) + " cues are in " + dir + " and readable";
+  c.message = "all " + std::to_string(names.size()) + " cues are in " + dir +
+              (set.speech_dir != dir ? " (the words in " + set.speech_dir + ")" : std::string()) + " and readable";
   return c;
 }
 
@@ -555,6 +600,7 @@ int doctor(Context& ctx) {
   run(held(check_camera(config.capture)));
   run(held(check_sound(config.feedback)));
   run(held(check_buzzer(config.feedback)));
+  if (config.feedback.button_enabled) run(held(check_button(config.feedback)));
   run(check_user(user, ctx.config_path, user == "stairguide"));
   run(check_sounds(config.feedback, user));
   run(check_rig());
@@ -587,7 +633,8 @@ int doctor(Context& ctx) {
 }  // namespace
 
 SG_COMMAND("doctor", "doctor [--json] [--user NAME]",
-           "check config, camera, sound, buzzer, service user, sounds and the running daemon; say how to fix "
+           "check config, camera, sound, buzzer, button (when enabled), service user, sounds and the running "
+           "daemon; say how to fix "
            "what is wrong (exit 0 when all is well)",
            doctor);
 
