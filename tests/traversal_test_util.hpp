@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/core/config.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stairs.hpp"

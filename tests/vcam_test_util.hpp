@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 
 namespace stairguide::test {
 

@@ -8,7 +8,7 @@
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/device.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 
 namespace fs = std::filesystem;
 

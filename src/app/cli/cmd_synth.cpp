@@ -9,7 +9,7 @@
 #include "cli/command.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 
 namespace stairguide::cli {
 namespace {

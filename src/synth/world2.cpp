@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "synthetic_internal.hpp"
+#include "internal.hpp"
 
 namespace stairguide::synth::detail {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic.hpp
+/// \file synth.hpp
 /// The synthetic stair world: scenes of simple solids, a chest-mounted camera on a trajectory,
 /// a Kinect-like sensor model, and per-frame ground truth. The project's ground truth for every
 /// accuracy claim (the seed's real datasets cannot be had here).
@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic_render.hpp"
-#include "stairguide/capture/synthetic_scene.hpp"
-#include "stairguide/capture/synthetic_trajectory.hpp"
+#include "stairguide/synth/render.hpp"
+#include "stairguide/synth/scene.hpp"
+#include "stairguide/synth/trajectory.hpp"
 
 namespace stairguide::synth {
 

@@ -2,8 +2,8 @@
 // render, apply the sensor model, compute the ground truth.
 #include <cmath>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "synthetic_internal.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "internal.hpp"
 
 namespace stairguide::synth {
 namespace {
