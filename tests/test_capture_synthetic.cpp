@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "stairguide/synth/synth.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 #include "stairguide/synth/builders.hpp"
 
 using namespace stairguide;

@@ -1,5 +1,5 @@
-// The synthetic FrameSource and the per-frame driver: build the preset's scene and camera,
-// render, apply the sensor model, compute the ground truth.
+// The per-frame driver: build the preset's scene and camera, render, apply the sensor model,
+// compute the ground truth (PresetRenderer; capture's synthetic FrameSource reads through it).
 #include <cmath>
 
 #include "stairguide/synth/synth.hpp"
@@ -70,61 +70,6 @@ void render_into(const Scene& scene, const WalkerState& walker, long index, std:
   truth.timestamp = frame.timestamp;
 }
 
-class SyntheticSource final : public FrameSource {
- public:
-  SyntheticSource(const std::string& preset, long frames, std::uint32_t seed, const SynthOptions& o)
-      : def_(need_preset(preset)), seed_(seed), options_(o) {
-    check_options(o);
-    frames_ = frames > 0 ? frames : def_.info.default_frames;
-    if (def_.sequence) {
-      detail::PresetBuild b;
-      Rng rng(build_seed(def_, seed, 0));
-      def_.build(rng, o, b);
-      scene_ = std::move(b.scene);
-      scene_.name = preset;
-      walk_ = Walk(b.walk, o.fps, frames_);
-    }
-  }
-
-  ReadResult read(RgbdFrame& out) override {
-    if (next_ >= frames_)
-      return {ReadStatus::kEnd,
-              describe() + ": end of sequence after " + std::to_string(frames_) + " frames"};
-    const long i = next_++;
-    if (def_.sequence) {
-      render_into(scene_, walk_.at(i), i, seed_, options_, buf_, out, truth_);
-    } else {
-      const PresetFrame pf = build_preset_frame(def_.info.name, i, seed_, options_);
-      render_into(pf.scene, pf.walker, i, seed_, options_, buf_, out, truth_);
-    }
-    has_truth_ = true;
-    return {};
-  }
-  CameraIntrinsics intrinsics() const override { return synthetic_intrinsics(options_); }
-  long frame_count() const override { return frames_; }
-  bool independent_frames() const override { return !def_.sequence; }
-  std::string describe() const override { return "synthetic " + def_.info.name; }
-  std::optional<FrameTruth> truth() const override {
-    if (!has_truth_) return std::nullopt;
-    return truth_;
-  }
-
- private:
-  const detail::PresetDef& def_;
-  std::uint32_t seed_;
-  SynthOptions options_;
-  long frames_ = 1;
-  long next_ = 0;
-  Scene scene_;
-  Walk walk_;
-  RenderBuffers buf_;
-  FrameTruth truth_;
-  bool has_truth_ = false;
-};
-
-}  // namespace
-
-namespace {
 // The public descriptions of a list of preset definitions.
 std::vector<PresetInfo> infos(const std::vector<detail::PresetDef>& defs) {
   std::vector<PresetInfo> v;
@@ -203,9 +148,31 @@ void render_preset_frame(const std::string& preset, long index, std::uint32_t se
   render_into(pf.scene, pf.walker, index, seed, options, buf, frame, truth);
 }
 
-std::unique_ptr<FrameSource> make_source(const std::string& preset, long frames, std::uint32_t seed,
-                                         const SynthOptions& options) {
-  return std::make_unique<SyntheticSource>(preset, frames, seed, options);
+PresetRenderer::PresetRenderer(const std::string& preset, long frames, std::uint32_t seed, const SynthOptions& o)
+    : def_(&need_preset(preset)), seed_(seed), options_(o) {
+  check_options(o);
+  frames_ = frames > 0 ? frames : def_->info.default_frames;
+  if (def_->sequence) {
+    detail::PresetBuild b;
+    Rng rng(build_seed(*def_, seed, 0));
+    def_->build(rng, o, b);
+    scene_ = std::move(b.scene);
+    scene_.name = preset;
+    walk_ = Walk(b.walk, o.fps, frames_);
+  }
 }
+
+void PresetRenderer::render(long index, RgbdFrame& frame, FrameTruth& truth) {
+  if (def_->sequence) {
+    render_into(scene_, walk_.at(index), index, seed_, options_, buf_, frame, truth);
+  } else {
+    const PresetFrame pf = build_preset_frame(def_->info.name, index, seed_, options_);
+    render_into(pf.scene, pf.walker, index, seed_, options_, buf_, frame, truth);
+  }
+}
+
+bool PresetRenderer::sequence() const { return def_->sequence; }
+
+const PresetInfo& PresetRenderer::info() const { return def_->info; }
 
 }  // namespace stairguide::synth
