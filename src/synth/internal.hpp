@@ -41,6 +41,11 @@ struct PresetDef {
   std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build;
 };
 
+// A preset's definition: its name, what it shows, the frames a full run takes (1 for a static
+// view), whether it is a sequence, and how it is built.
+PresetDef def(const char* name, const char* summary, long frames, bool sequence,
+              std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build);
+
 const std::vector<PresetDef>& preset_defs();
 // The world's stairs (synth::world_presets()), apart from preset_defs().
 const std::vector<PresetDef>& world_preset_defs();

@@ -486,20 +486,9 @@ void descending_people_approach(Rng& rng, const SynthOptions& o, PresetBuild& b)
   w.heading = [](double t) { return deg2rad(4.f) * static_cast<float>(std::sin(0.7 * t)); };
 }
 
-PresetDef def(const char* name, const char* summary, long frames, bool seq, Fn fn) {
-  PresetDef d;
-  d.info.name = name;
-  d.info.summary = summary;
-  d.info.default_frames = frames;
-  d.sequence = seq;
-  d.build = fn;
-  return d;
-}
-
 }  // namespace presets
 
 using namespace presets;
-
 
 const std::vector<PresetDef>& preset_defs() {
   static const std::vector<PresetDef> defs = {
@@ -548,6 +537,17 @@ const std::vector<PresetDef>& preset_defs() {
           floor_only_static),
   };
   return defs;
+}
+
+PresetDef def(const char* name, const char* summary, long frames, bool sequence,
+              std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build) {
+  PresetDef d;
+  d.info.name = name;
+  d.info.summary = summary;
+  d.info.default_frames = frames;
+  d.sequence = sequence;
+  d.build = std::move(build);
+  return d;
 }
 
 const PresetDef* find_preset(const std::string& name) {

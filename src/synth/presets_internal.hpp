@@ -1,7 +1,7 @@
 #pragma once
 // What the first world's preset files share (not part of the public API): views from the origin,
-// rooms, a staircase ahead, a walk's camera and its support along a flight, and the PresetDef
-// maker. presets.cpp defines them (with the paper's presets and the registry); presets_world.cpp,
+// rooms, a staircase ahead, a walk's camera and its support along a flight. presets.cpp defines
+// them (with the paper's presets and the registry); presets_world.cpp,
 // presets_rig.cpp and walks.cpp use them.
 #include "internal.hpp"
 
@@ -29,8 +29,5 @@ void room(Rng& rng, PresetBuild& b);
 void sequence_camera(Rng& rng, const SynthOptions& o, WalkSpec& w);
 // Walk geometry along +x through a staircase whose first edge is at x = edge_x.
 void stair_walk(WalkSpec& w, const StairSpec& st, float edge_x);
-
-using Fn = void (*)(Rng&, const SynthOptions&, PresetBuild&);
-PresetDef def(const char* name, const char* summary, long frames, bool seq, Fn fn);
 
 }  // namespace stairguide::synth::detail::presets

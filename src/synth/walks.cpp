@@ -105,13 +105,8 @@ long flight_frames(const FlightWalk& fw) {
 }
 
 PresetDef flight_def(const char* name, const char* summary, const FlightWalk& fw) {
-  PresetDef d;
-  d.info.name = name;
-  d.info.summary = summary;
-  d.info.default_frames = flight_frames(fw);
-  d.sequence = true;
-  d.build = [fw](Rng& r, const SynthOptions& o, PresetBuild& b) { flight_walk(r, o, b, fw); };
-  return d;
+  return def(name, summary, flight_frames(fw), true,
+             [fw](Rng& r, const SynthOptions& o, PresetBuild& b) { flight_walk(r, o, b, fw); });
 }
 
 FlightWalk flight(StairKind kind, int steps, float rate_lo, float rate_hi, bool pause_turn = false,

@@ -566,14 +566,9 @@ void lowrig_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
 
 using Fn = void (*)(Rng&, const SynthOptions&, PresetBuild&);
 
+// A static view: one frame, drawn anew for every index.
 PresetDef def(const char* name, const char* summary, Fn fn) {
-  PresetDef d;
-  d.info.name = name;
-  d.info.summary = summary;
-  d.info.default_frames = 1;
-  d.sequence = false;
-  d.build = fn;
-  return d;
+  return detail::def(name, summary, 1, false, fn);
 }
 
 }  // namespace
