@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <string>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace sgtest {

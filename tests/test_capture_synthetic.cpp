@@ -7,8 +7,8 @@
 #include <map>
 #include <set>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/capture/synthetic_builders.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/synth/builders.hpp"
 
 using namespace stairguide;
 using namespace stairguide::synth;

@@ -10,7 +10,7 @@
 
 #include "cli_test_util.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 
 namespace fs = std::filesystem;
 using cli_test::CliRun;

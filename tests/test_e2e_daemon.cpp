@@ -22,7 +22,7 @@
 #include "daemon_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 #include "stairguide/config/config_loader.hpp"
 
 namespace fs = std::filesystem;

@@ -333,8 +333,8 @@ TEST(PerceptionRendered, DescendingStairs) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The synthetic presets (capture/synthetic.hpp), fixed seeds.
-#include "stairguide/capture/synthetic.hpp"
+// The synthetic presets (synth/synth.hpp), fixed seeds.
+#include "stairguide/synth/synth.hpp"
 
 namespace {
 

@@ -15,7 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/edge_compass.hpp"
 #include "stairguide/perception/manhattan_frame.hpp"
 #include "stairguide/perception/perception.hpp"

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <string>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/capture/synthetic_render.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "stairguide/synth/render.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "manhattan_test_util.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
 
 using namespace stairguide;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace {

@@ -9,9 +9,9 @@
 #include <optional>
 #include <string>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/capture/synthetic_builders.hpp"
-#include "stairguide/capture/synthetic_render.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/synth/builders.hpp"
+#include "stairguide/synth/render.hpp"
 #include "stairguide/perception/perception.hpp"
 
 using namespace stairguide;

@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/capture/synthetic_builders.hpp"
-#include "stairguide/capture/synthetic_render.hpp"
-#include "stairguide/capture/synthetic_trajectory.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "stairguide/synth/builders.hpp"
+#include "stairguide/synth/render.hpp"
+#include "stairguide/synth/trajectory.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 #include <cmath>
 #include <string>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
 
 using namespace stairguide;

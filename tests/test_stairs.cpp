@@ -12,7 +12,7 @@
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/config/config_loader.hpp"
 #include "stairguide/stairs/stair_checks.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "test_stairs_scene.hpp"
 

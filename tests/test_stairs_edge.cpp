@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "synth_stairs_test_util.hpp"
 #include "test_stairs_scene.hpp"

@@ -16,7 +16,7 @@
 #include "stairguide/config/config_loader.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_checks.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "synth_stairs_test_util.hpp"
 
 namespace {

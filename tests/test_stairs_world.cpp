@@ -11,7 +11,7 @@
 #include <map>
 #include <string>
 
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "synth_stairs_test_util.hpp"
 
 namespace {

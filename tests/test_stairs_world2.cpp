@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "synth_stairs_test_util.hpp"
 
 namespace {

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/scene.hpp"
 #include "stairguide/runtime/pipeline.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stair_result.hpp"
 
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 
 namespace stairguide::test {
 

@@ -8,7 +8,7 @@
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/device.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 
 namespace fs = std::filesystem;
 

@@ -4,20 +4,14 @@
 
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
 #include "stairguide/core/config.hpp"
 #include "stairguide/core/ground_truth.hpp"
+#include "stairguide/core/source_error.hpp"
 #include "stairguide/core/types.hpp"
 
 namespace stairguide {
-
-/// Thrown when a source cannot be opened; the message names the file or device and the problem.
-class SourceError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 enum class ReadStatus {
   kOk,       ///< a frame was read

@@ -32,7 +32,7 @@
 #include "cli/bench_util.hpp"
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/capture/synthetic_source.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace stairguide::cli {

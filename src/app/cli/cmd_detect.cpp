@@ -11,8 +11,8 @@
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stair_checks.hpp"
-#include "stairguide/stairs/stair_draw.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_draw.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace stairguide::cli {

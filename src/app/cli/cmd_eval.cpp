@@ -12,9 +12,9 @@
 
 #include "cli/command.hpp"
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace fs = std::filesystem;

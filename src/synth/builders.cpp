@@ -3,7 +3,7 @@
 // at the first edge), so every height below reads as height above that floor. Solid stairs are
 // columns standing on the floor (one per tread), which leaves no crack between a tread and the
 // riser above it, whatever the rasterisation rounding.
-#include "stairguide/capture/synthetic_builders.hpp"
+#include "stairguide/synth/builders.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 
 namespace stairguide::synth {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic_render.hpp
+/// \file render.hpp
 /// Renderer and sensor model of the synthetic stair world.
 ///
 /// `render` rasterises the scene's planar faces with an inverse-depth buffer (exact per-pixel
@@ -11,7 +11,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "stairguide/capture/synthetic_scene.hpp"
+#include "stairguide/synth/scene.hpp"
 #include "stairguide/core/types.hpp"
 
 namespace stairguide::synth {

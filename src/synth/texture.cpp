@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "stairguide/capture/synthetic_builders.hpp"
-#include "synthetic_internal.hpp"
+#include "stairguide/synth/builders.hpp"
+#include "internal.hpp"
 
 namespace stairguide::synth::detail {
 namespace {

@@ -2,18 +2,16 @@
 // draw every frame as an independent random view; sequences walk a trajectory through one scene.
 // Distributions follow the brief: camera height 1.0-1.6 m, tilt 30-60 deg, roll +-3 deg, the
 // staircase 0.8-3.0 m ahead, heading +-25 deg; riser 15-18 cm, tread 28-32 cm, width 0.9-1.6 m,
-// 4-12 steps. The world's stairs (world_preset_defs, at the end) draw from the building codes of
-// the world instead.
+// 4-12 steps. The world's stairs (presets_world.cpp) draw from the building codes of the world
+// instead; the rig views are in presets_rig.cpp, the traversal walks in walks.cpp. This file also
+// holds the registry of every preset (find_preset).
 #include <algorithm>
 #include <cmath>
 
-#include "synthetic_internal.hpp"
+#include "presets_internal.hpp"
 
 namespace stairguide::synth::detail {
-namespace {
-
-using V3 = Eigen::Vector3f;
-using V2 = Eigen::Vector2f;
+namespace presets {
 
 float pick(float v, float fallback) { return std::isnan(v) ? fallback : v; }
 
@@ -21,7 +19,7 @@ float pick(float v, float fallback) { return std::isnan(v) ? fallback : v; }
 // `heading` (rad), the camera h_lo..h_hi m high and tilted tilt_lo..tilt_hi deg down unless the
 // options fix them; the height and tilt drawn are returned through `height` / `tilt_out`.
 WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo, float tilt_hi,
-                             float heading, float yaw_range_deg, float* height = nullptr, float* tilt_out = nullptr) {
+                             float heading, float yaw_range_deg, float* height, float* tilt_out) {
   const float h = pick(o.camera_height_m, rng.uniform(h_lo, h_hi));
   const float tilt = deg2rad(pick(o.camera_tilt_deg, rng.uniform(tilt_lo, tilt_hi)));
   const float roll = deg2rad(pick(o.camera_roll_deg, rng.uniform(-3.f, 3.f)));
@@ -38,7 +36,7 @@ WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float 
 }
 
 // A random chest-camera view from the world origin, looking roughly along `heading` (rad).
-WalkerState random_view(Rng& rng, const SynthOptions& o, float heading = 0.f, float yaw_range_deg = 25.f) {
+WalkerState random_view(Rng& rng, const SynthOptions& o, float heading, float yaw_range_deg) {
   return view_from_origin(rng, o, 1.0f, 1.6f, 30.f, 60.f, heading, yaw_range_deg);
 }
 
@@ -54,15 +52,14 @@ StairParams random_stair(Rng& rng, StairKind kind) {
   return p;
 }
 
-void floor_and_room(Scene& s, Rng& rng, const V2& lo, const V2& hi, float floor_z = 0.f,
-                    float wall_bottom = 0.f) {
+void floor_and_room(Scene& s, Rng& rng, const V2& lo, const V2& hi, float floor_z, float wall_bottom) {
   s.add_box_world(V3(lo.x() - 1.f, lo.y() - 1.f, floor_z - 0.2f), V3(hi.x() + 1.f, hi.y() + 1.f, floor_z),
                   floor_material(rng), "floor");
   add_room_walls(s, lo, hi, wall_bottom, 2.7f - wall_bottom + floor_z, wall_material(rng));
 }
 
 // Staircase 0.8-3.0 m ahead of the user at the origin, travel direction `yaw`.
-Pose stair_ahead(Rng& rng, float yaw, float edge_z, float* dist = nullptr) {
+Pose stair_ahead(Rng& rng, float yaw, float edge_z, float* dist) {
   const float d = rng.uniform(0.8f, 3.0f);
   const float lat = rng.uniform(-0.3f, 0.3f);
   if (dist) *dist = d;
@@ -489,195 +486,9 @@ void descending_people_approach(Rng& rng, const SynthOptions& o, PresetBuild& b)
   w.heading = [](double t) { return deg2rad(4.f) * static_cast<float>(std::sin(0.7 * t)); };
 }
 
-// ---- the world's stairs (world_preset_defs): the range of the building codes, not the paper's ----
+}  // namespace presets
 
-// Riser, tread, width, nosing and length from the codes of the world (SOURCES.md): risers 10-22
-// cm, treads 20-45 cm, 2R+T 50-72 cm (riser and tread drawn together until they satisfy it), narrow
-// flights (0.65-0.9 m) and wide ones (1.8-2.6 m) as well as the usual, nosings on 40%.
-StairParams world_stair(Rng& rng, StairKind kind) {
-  StairParams p;
-  p.kind = kind;
-  p.steps = rng.integer(2, 14);
-  for (int i = 0; i < 100; ++i) {
-    p.riser_m = rng.uniform(0.10f, 0.22f);
-    p.tread_m = rng.uniform(0.20f, 0.45f);
-    const float blondel = 2.f * p.riser_m + p.tread_m;
-    if (blondel >= 0.50f && blondel <= 0.72f) break;
-  }
-  const float w = rng.uniform();
-  p.width_m =
-      w < 0.25f ? rng.uniform(0.65f, 0.9f) : (w < 0.45f ? rng.uniform(1.8f, 2.6f) : rng.uniform(0.9f, 1.8f));
-  p.nosing_m = rng.chance(0.4f) ? rng.uniform(0.01f, 0.04f) : 0.f;
-  p.wall_start_m = rng.uniform(-1.5f, 0.f);
-  p.top_depth_m = rng.uniform(1.2f, 3.f);
-  return p;
-}
-
-void world_ascending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  StairParams p = world_stair(rng, StairKind::kAscending);
-  float d = 0.f;
-  p.T_world_stair = stair_ahead(rng, 0.f, p.riser_m, &d);
-  p.open_risers = rng.chance(0.2f);
-  if (p.open_risers) p.nosing_m = 0.f;
-  p.side_walls = !p.open_risers && rng.chance(0.6f);
-  p.handrails = rng.chance(0.5f);
-  const bool landing = p.steps >= 3 && rng.chance(0.25f);
-  if (landing) p.top_depth_m = rng.uniform(0.9f, 1.5f);
-  float end = d + static_cast<float>(p.steps - 1) * p.tread_m + p.top_depth_m;
-  StairParams q = p;
-  if (landing) {  // a landing, then a second flight of the same steps
-    const float landing_z = static_cast<float>(p.steps) * p.riser_m;
-    q.steps = rng.integer(2, 6);
-    q.base_z = landing_z;
-    q.wall_start_m = 0.f;
-    q.top_depth_m = 2.f;
-    q.T_world_stair.translation() =
-        p.T_world_stair * Eigen::Vector3f(0.f, landing_z - p.riser_m + q.riser_m, end - d);
-    end += static_cast<float>(q.steps - 1) * q.tread_m + q.top_depth_m;
-  }
-  const float half = 0.5f * p.width_m + rng.uniform(0.2f, 2.5f);
-  floor_and_room(b.scene, rng, V2(-3.f, -half - 0.5f), V2(end + 0.2f, half + 0.5f));
-  add_staircase(b.scene, p, rng);
-  if (landing) add_staircase(b.scene, q, rng);
-  b.view = random_view(rng, o);
-}
-
-void world_descending_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  descending_in_room(rng, o, b, world_stair(rng, StairKind::kDescending));
-}
-
-// ---- traversal walks (issue 32): climbs and descents of 3, 8 and 14 steps onto a landing ----
-
-struct FlightWalk {
-  StairKind kind = StairKind::kAscending;
-  int steps = 8;
-  float rate_lo = 0.8f, rate_hi = 1.0f;  // steps per second on the flight
-  bool pause_turn = false;  // stop halfway up (or down) and look round to the left and back
-  bool person = false;      // a person standing at one side of the flight, facing the user
-};
-
-// Stand, walk ~2 m to the first edge, take the flight at the preset's rate (one tread per step),
-// walk on along the landing, stand. With `pause_turn`, the walker stops on the middle tread for
-// 2.4 s and turns 40 deg to the left and back while standing there.
-void flight_walk(Rng& rng, const SynthOptions& o, PresetBuild& b, const FlightWalk& fw) {
-  StairParams p;
-  p.kind = fw.kind;
-  p.steps = fw.steps;
-  p.riser_m = rng.uniform(0.155f, 0.18f);
-  p.tread_m = rng.uniform(0.28f, 0.32f);
-  p.width_m = rng.uniform(1.1f, 1.5f);
-  p.side_walls = true;
-  p.handrails = rng.chance(0.5f);
-  p.wall_start_m = -0.8f;
-  p.top_depth_m = rng.uniform(1.8f, 2.6f);  // the landing (ascending) or the lower floor (descending)
-  const bool down = fw.kind == StairKind::kDescending;
-  const float edge_x = 2.4f;
-  const float N = static_cast<float>(p.steps);
-  p.T_world_stair = stair_pose(edge_x, 0.f, 0.f, down ? 0.f : p.riser_m);
-  const float total = N * p.riser_m;
-  const float end = edge_x + (N - 1.f) * p.tread_m + p.top_depth_m;
-  if (down) {
-    add_room_walls(b.scene, V2(-2.f, -2.4f), V2(end + 0.1f, 2.4f), -total - 0.2f, 2.9f + total, wall_material(rng));
-  } else {
-    floor_and_room(b.scene, rng, V2(-2.f, -2.2f), V2(end + 0.1f, 2.2f));
-  }
-  add_crate(b.scene, V3(0.8f, down ? 1.9f : -1.7f, 0.f), 0.2f, V3(0.5f, 0.4f, 0.45f), wood_material(rng), "clutter");
-  const int id = add_staircase(b.scene, p, rng);
-  const StairSpec& st = b.scene.stairs[static_cast<std::size_t>(id)];
-  float walker_y = 0.f;
-  if (fw.person) {
-    // At one side, two thirds of the way along the flight, facing down the flight toward the user;
-    // the walker keeps to the other side.
-    const float side = rng.chance(0.5f) ? 1.f : -1.f;
-    const int k = std::max(2, (2 * p.steps) / 3);
-    const V3 feet(edge_x + (static_cast<float>(k) - 0.5f) * st.tread_m, side * (0.5f * st.width_m - 0.28f),
-                  st.tread_height(k));
-    add_person(b.scene, feet, 3.14159265f + rng.uniform(-0.3f, 0.3f), rng.uniform(1.6f, 1.85f), rng);
-    walker_y = -side * 0.22f;
-  }
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
-  w.start = V3(0.f, walker_y, 0.f);
-  stair_walk(w, st, edge_x);
-  const float rate = rng.uniform(fw.rate_lo, fw.rate_hi);
-  const double step_s = 1.0 / rate;
-  const float stop = edge_x - (down ? 0.25f : 0.35f);
-  const float last = edge_x + (N - 1.f) * p.tread_m + 0.35f;  // on the landing, past the last edge
-  const double t_walk0 = 0.6, t_walk1 = 2.6, t_cross0 = 3.0;
-  const double cross_s = step_s * static_cast<double>(p.steps);
-  // The pause: on the middle tread's centre.
-  const int mid = std::max(1, p.steps / 2);
-  const float s_pause = edge_x + (static_cast<float>(mid) - 0.5f) * p.tread_m;
-  const double f_pause = (s_pause - stop) / (last - stop);
-  const double pause_s = fw.pause_turn ? 2.4 : 0.0;
-  const double t_pause0 = t_cross0 + f_pause * cross_s, t_pause1 = t_pause0 + pause_s;
-  const double t_cross1 = t_cross0 + cross_s + pause_s;
-  w.duration_s = static_cast<float>(t_cross1 + 2.5);
-  w.distance = [=](double t) -> float {
-    if (t < t_cross0)
-      return stop * smooth_ramp(static_cast<float>(t), static_cast<float>(t_walk0), static_cast<float>(t_walk1));
-    double u = t - t_cross0;  // time walking on the flight
-    if (t >= t_pause0) u -= std::min(t - t_pause0, pause_s);
-    if (u < cross_s) return stop + (last - stop) * static_cast<float>(u / cross_s);
-    return last + 1.0f * smooth_ramp(static_cast<float>(t), static_cast<float>(t_cross1),
-                                     static_cast<float>(t_cross1 + 2.0));
-  };
-  const bool turn = fw.pause_turn;
-  w.heading = [=](double t) {
-    float h = deg2rad(3.f) * static_cast<float>(std::sin(0.6 * t));
-    if (turn && t >= t_pause0 && t <= t_pause1) {
-      const float tt = static_cast<float>(t);
-      h += deg2rad(40.f) * (smooth_ramp(tt, static_cast<float>(t_pause0 + 0.2), static_cast<float>(t_pause0 + 0.9)) -
-                            smooth_ramp(tt, static_cast<float>(t_pause1 - 0.9), static_cast<float>(t_pause1 - 0.2)));
-    }
-    return h;
-  };
-}
-
-// Frames a flight walk takes at 30 Hz (its slowest rate).
-long flight_frames(const FlightWalk& fw) {
-  const double cross = static_cast<double>(fw.steps) / fw.rate_lo + (fw.pause_turn ? 2.4 : 0.0);
-  return static_cast<long>(std::ceil((3.0 + cross + 2.5) * 30.0));
-}
-
-PresetDef flight_def(const char* name, const char* summary, const FlightWalk& fw);
-
-using Fn = void (*)(Rng&, const SynthOptions&, PresetBuild&);
-
-PresetDef def(const char* name, const char* summary, long frames, bool seq, Fn fn) {
-  PresetDef d;
-  d.info.name = name;
-  d.info.summary = summary;
-  d.info.default_frames = frames;
-  d.sequence = seq;
-  d.build = fn;
-  return d;
-}
-
-PresetDef flight_def(const char* name, const char* summary, const FlightWalk& fw) {
-  PresetDef d;
-  d.info.name = name;
-  d.info.summary = summary;
-  d.info.default_frames = flight_frames(fw);
-  d.sequence = true;
-  d.build = [fw](Rng& r, const SynthOptions& o, PresetBuild& b) { flight_walk(r, o, b, fw); };
-  return d;
-}
-
-FlightWalk flight(StairKind kind, int steps, float rate_lo, float rate_hi, bool pause_turn = false,
-                  bool person = false) {
-  FlightWalk f;
-  f.kind = kind;
-  f.steps = steps;
-  f.rate_lo = rate_lo;
-  f.rate_hi = rate_hi;
-  f.pause_turn = pause_turn;
-  f.person = person;
-  return f;
-}
-
-}  // namespace
+using namespace presets;
 
 const std::vector<PresetDef>& preset_defs() {
   static const std::vector<PresetDef> defs = {
@@ -728,106 +539,15 @@ const std::vector<PresetDef>& preset_defs() {
   return defs;
 }
 
-const std::vector<PresetDef>& world_preset_defs() {
-  static const std::vector<PresetDef> defs = {
-      def("world_ascending_static",
-          "random views of an ascending flight drawn from the world's codes (riser 10-22, tread 20-45 cm, "
-          "2R+T "
-          "50-72 cm, width 0.65-2.6 m, 2-14 steps; nosings, open risers, landings)",
-          1, false, world_ascending_static),
-      def("world_descending_static", "random views of a descending flight drawn from the world's codes", 1,
-          false, world_descending_static),
-  };
-  return defs;
-}
-
-// ---- any chest or waist rig (rig_defs): the camera anywhere in 0.5-1.8 m, tilted 15-80 deg ----
-
-namespace {
-
-// A view from a rig of any height and tilt: a waist-mounted camera at 0.5 m looking nearly level,
-// a chest one at 1.8 m looking almost straight down. Drawn from the range the issue asks the
-// floor to cope with, not from the floor detector's gate.
-WalkerState rig_view(Rng& rng, const SynthOptions& o, float* height = nullptr, float* tilt_out = nullptr) {
-  return view_from_origin(rng, o, 0.5f, 1.8f, 15.f, 80.f, 0.f, 25.f, height, tilt_out);
-}
-
-// A large horizontal surface 0.4-0.8 m below the camera (lower rigs: a low one, 0.25-0.45 m high),
-// framed in the view with the floor around it: a table, a bed, a bench, or a raised landing (a
-// closed box of concrete, a mezzanine seen from the floor).
-void rig_furniture_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  room(rng, b);
-  float h = 1.f, tilt = 0.7f;
-  b.view = rig_view(rng, o, &h, &tilt);
-  float top = h - rng.uniform(0.4f, 0.8f);
-  if (top < 0.25f) top = rng.uniform(0.25f, std::max(0.26f, std::min(0.45f, h - 0.1f)));
-  // Where the optical axis meets the floor (far out for a nearly level camera): the surface's
-  // near edge lies somewhere from under a third of that to past it.
-  const float centre = std::min(3.5f, h / std::tan(std::max(tilt, 0.2f)));
-  const float near_edge = std::clamp(rng.uniform(0.3f, 1.4f) * centre, 0.35f, 3.0f);
-  const float lat = rng.uniform(-0.6f, 0.6f);
-  const float yaw = b.view.yaw + rng.uniform(-0.4f, 0.4f);
-  const V3 fwd(std::cos(b.view.yaw), std::sin(b.view.yaw), 0.f), left(-fwd.y(), fwd.x(), 0.f);
-  const int kind = rng.integer(0, 3);
-  if (kind == 0) {  // table
-    const float len = rng.uniform(1.0f, 1.8f), dep = rng.uniform(0.6f, 0.9f);
-    add_table(b.scene, (near_edge + 0.5f * dep) * fwd + lat * left, yaw + 1.5707963f, top, len, dep, rng);
-  } else if (kind == 1) {  // bed
-    const V3 size(rng.uniform(1.9f, 2.1f), rng.uniform(0.9f, 1.6f), top);
-    add_crate(b.scene, (near_edge + 0.5f * size.x()) * fwd + lat * left, yaw, size, fabric_material(rng), "bed");
-  } else if (kind == 2) {  // bench
-    add_bench(b.scene, (near_edge + 0.2f) * fwd + lat * left, yaw + 1.5707963f, top, rng.uniform(1.2f, 2.0f), rng);
-  } else {  // a raised landing
-    const V3 size(rng.uniform(1.2f, 2.5f), rng.uniform(1.2f, 2.5f), top);
-    add_crate(b.scene, (near_edge + 0.5f * size.x()) * fwd + lat * left, yaw, size, concrete_material(rng),
-              "landing");
-  }
-}
-
-}  // namespace
-
-const std::vector<PresetDef>& rig_defs() {
-  static const std::vector<PresetDef> defs = {
-      def("rig_floor_static", "an empty room seen from any rig: camera 0.5-1.8 m high, tilted 15-80 deg", 1, false,
-          [](Rng& rng, const SynthOptions& o, PresetBuild& b) {
-            room(rng, b);
-            b.view = rig_view(rng, o);
-          }),
-      def("rig_furniture_static",
-          "any rig (0.5-1.8 m, 15-80 deg) before a table, bed, bench or raised landing 0.4-0.8 m below the camera", 1,
-          false, rig_furniture_static),
-  };
-  return defs;
-}
-
-const std::vector<PresetDef>& walk_defs() {
-  static const std::vector<PresetDef> defs = {
-      // Traversal walks (issue 32): the step under the body is each frame's truth (user_step).
-      flight_def("climb_3_steps", "walk ~2 m to a 3-step flight, climb it at 0.5-0.7 steps/s onto a landing",
-                 flight(StairKind::kAscending, 3, 0.5f, 0.7f)),
-      flight_def("climb_8_steps", "walk ~2 m to an 8-step flight, climb it at 0.8-1.0 steps/s onto a landing",
-                 flight(StairKind::kAscending, 8, 0.8f, 1.0f)),
-      flight_def("climb_14_steps", "walk ~2 m to a 14-step flight, climb it at 1.0-1.2 steps/s onto a landing",
-                 flight(StairKind::kAscending, 14, 1.0f, 1.2f)),
-      flight_def("climb_8_pause_turn",
-                 "climb 8 steps at 0.7-0.9 steps/s, stopping on the middle one to look 40 deg left and back",
-                 flight(StairKind::kAscending, 8, 0.7f, 0.9f, true)),
-      flight_def("climb_8_person", "climb 8 steps at 0.8-1.0 steps/s past a person standing at one side of the flight",
-                 flight(StairKind::kAscending, 8, 0.8f, 1.0f, false, true)),
-      flight_def("descend_3_steps", "walk ~2 m to the top of a 3-step flight, go down at 0.5-0.7 steps/s",
-                 flight(StairKind::kDescending, 3, 0.5f, 0.7f)),
-      flight_def("descend_8_steps", "walk ~2 m to the top of an 8-step flight, go down at 0.8-1.0 steps/s",
-                 flight(StairKind::kDescending, 8, 0.8f, 1.0f)),
-      flight_def("descend_14_steps", "walk ~2 m to the top of a 14-step flight, go down at 1.0-1.2 steps/s",
-                 flight(StairKind::kDescending, 14, 1.0f, 1.2f)),
-      flight_def("descend_8_pause_turn",
-                 "go down 8 steps at 0.7-0.9 steps/s, stopping on the middle one to look 40 deg left and back",
-                 flight(StairKind::kDescending, 8, 0.7f, 0.9f, true)),
-      flight_def("descend_8_person",
-                 "go down 8 steps at 0.8-1.0 steps/s past a person standing at one side of the flight",
-                 flight(StairKind::kDescending, 8, 0.8f, 1.0f, false, true)),
-  };
-  return defs;
+PresetDef def(const char* name, const char* summary, long frames, bool sequence,
+              std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build) {
+  PresetDef d;
+  d.info.name = name;
+  d.info.summary = summary;
+  d.info.default_frames = frames;
+  d.sequence = sequence;
+  d.build = std::move(build);
+  return d;
 }
 
 const PresetDef* find_preset(const std::string& name) {

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "synthetic_internal.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "internal.hpp"
 
 namespace stairguide::synth {
 namespace {

@@ -3,7 +3,7 @@
 // frequency), a little pitch nod, all scaled by walking speed; standing still leaves a small
 // breathing sway. Samples are integrated at 10x the frame rate so the gait phase follows the
 // distance walked even when the step length changes (treads on stairs).
-#include "stairguide/capture/synthetic_trajectory.hpp"
+#include "stairguide/synth/trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>

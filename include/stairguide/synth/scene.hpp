@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic_scene.hpp
+/// \file scene.hpp
 /// Scenes of the synthetic stair world: convex solids (oriented boxes, cylinders approximated by
 /// prisms) whose planar faces the renderer rasterises, plus the staircases' exact geometry for
 /// the ground truth. World frame: z up, origin on the floor the user starts on.
@@ -14,7 +14,7 @@
 
 namespace stairguide::synth {
 
-/// Procedural texture families (tileable, made once per process; see synthetic_texture.cpp).
+/// Procedural texture families (tileable, made once per process; see src/synth/texture.cpp).
 enum class Texture : std::uint8_t { kPlain, kTiles, kWood, kCarpet, kConcrete, kFabric, kCount };
 
 /// Surface appearance: Lambert reflectance modulated by a procedural texture.

@@ -1,4 +1,4 @@
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 
 #include "stairguide/core/json.hpp"
 

@@ -1,6 +1,6 @@
 // Solids and their faces. Every solid is convex, so the renderer can treat each face as an
 // independent convex polygon with back-face culling and an inverse-depth buffer.
-#include "stairguide/capture/synthetic_scene.hpp"
+#include "stairguide/synth/scene.hpp"
 
 #include <cmath>
 

@@ -2,7 +2,7 @@
 // Internals shared by the synthetic world's .cpp files (not part of the public API).
 #include <cstdint>
 
-#include "stairguide/capture/synthetic_scene.hpp"
+#include "stairguide/synth/scene.hpp"
 
 namespace stairguide::synth::detail {
 
@@ -21,8 +21,8 @@ constexpr std::uint32_t kGaussianMask = 0xFFFF;
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "stairguide/capture/synthetic_builders.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "stairguide/synth/builders.hpp"
 
 namespace stairguide::synth::detail {
 
@@ -41,14 +41,19 @@ struct PresetDef {
   std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build;
 };
 
+// A preset's definition: its name, what it shows, the frames a full run takes (1 for a static
+// view), whether it is a sequence, and how it is built.
+PresetDef def(const char* name, const char* summary, long frames, bool sequence,
+              std::function<void(Rng& rng, const SynthOptions& o, PresetBuild& out)> build);
+
 const std::vector<PresetDef>& preset_defs();
 // The world's stairs (synth::world_presets()), apart from preset_defs().
 const std::vector<PresetDef>& world_preset_defs();
-/// The traversal walks (synthetic.hpp: walk_presets()).
+/// The traversal walks (synth.hpp: walk_presets()).
 const std::vector<PresetDef>& walk_defs();
-/// Views from any chest or waist rig (synthetic.hpp: rig_presets()).
+/// Views from any chest or waist rig (synth.hpp: rig_presets()).
 const std::vector<PresetDef>& rig_defs();
-/// The second world (synthetic.hpp: world2_presets()), in synthetic_world2.cpp.
+/// The second world (synth.hpp: world2_presets()), in world2.cpp.
 const std::vector<PresetDef>& world2_defs();
 // nullptr when unknown.
 const PresetDef* find_preset(const std::string& name);

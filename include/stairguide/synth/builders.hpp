@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic_builders.hpp
+/// \file builders.hpp
 /// Building blocks of the synthetic scenes: a portable seeded random generator, staircases
 /// (ascending, descending, open risers, nosings, landings, side walls, handrails), single steps,
 /// curbs, rooms, doors, furniture and people.
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "stairguide/capture/synthetic_scene.hpp"
+#include "stairguide/synth/scene.hpp"
 
 namespace stairguide::synth {
 

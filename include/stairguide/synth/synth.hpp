@@ -1,19 +1,20 @@
 #pragma once
-/// \file synthetic.hpp
+/// \file synth.hpp
 /// The synthetic stair world: scenes of simple solids, a chest-mounted camera on a trajectory,
 /// a Kinect-like sensor model, and per-frame ground truth. The project's ground truth for every
 /// accuracy claim (the seed's real datasets cannot be had here).
 
 #include <cstdint>
 #include <limits>
-#include <memory>
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic_render.hpp"
-#include "stairguide/capture/synthetic_scene.hpp"
-#include "stairguide/capture/synthetic_trajectory.hpp"
+#include "stairguide/core/ground_truth.hpp"
+#include "stairguide/core/source_error.hpp"
+#include "stairguide/core/types.hpp"
+#include "stairguide/synth/render.hpp"
+#include "stairguide/synth/scene.hpp"
+#include "stairguide/synth/trajectory.hpp"
 
 namespace stairguide::synth {
 
@@ -185,11 +186,38 @@ void render_preset_frame(const std::string& preset, long index, std::uint32_t se
 /// scaled to options.width x options.height.
 CameraIntrinsics synthetic_intrinsics(const SynthOptions& options);
 
-/// A FrameSource rendering a preset frame by frame; `truth()` gives each frame's ground truth.
-/// `frames` <= 0 takes the preset's default_frames; a sequence asked for more frames than its
-/// default holds its final pose. Timestamps are index / fps.
-/// Throws SourceError for an unknown preset name (the message lists the known ones) or bad options.
-std::unique_ptr<FrameSource> make_source(const std::string& preset, long frames, std::uint32_t seed,
-                                         const SynthOptions& options = {});
+namespace detail {
+struct PresetDef;
+}  // namespace detail
+
+/// Renders the frames of one preset in turn, keeping a sequence's scene and walk between frames:
+/// what the synthetic FrameSource (capture/synthetic_source.hpp, `synth:` inputs) reads.
+class PresetRenderer {
+ public:
+  /// `frames` <= 0 takes the preset's default_frames; a sequence asked for more frames than its
+  /// default holds its final pose. Throws SourceError for an unknown preset name (the message lists
+  /// the known ones) or bad options.
+  PresetRenderer(const std::string& preset, long frames, std::uint32_t seed, const SynthOptions& options = {});
+
+  /// Renders frame `index` (0 .. frames() - 1) into `frame` (depth, colour, grey, timestamp
+  /// index / fps, intrinsics) and its ground truth into `truth`.
+  void render(long index, RgbdFrame& frame, FrameTruth& truth);
+
+  long frames() const { return frames_; }
+  /// True for a walk (one scene, a trajectory); false for a static preset, which draws a new scene
+  /// and view for every index (consecutive frames are unrelated).
+  bool sequence() const;
+  const PresetInfo& info() const;
+  CameraIntrinsics intrinsics() const { return synthetic_intrinsics(options_); }
+
+ private:
+  const detail::PresetDef* def_;
+  std::uint32_t seed_;
+  SynthOptions options_;
+  long frames_ = 1;
+  Scene scene_;  // sequences: built once
+  Walk walk_;
+  RenderBuffers buf_;
+};
 
 }  // namespace stairguide::synth

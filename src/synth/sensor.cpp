@@ -10,8 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "stairguide/capture/synthetic.hpp"
-#include "synthetic_internal.hpp"
+#include "stairguide/synth/synth.hpp"
+#include "internal.hpp"
 
 namespace stairguide::synth {
 namespace {

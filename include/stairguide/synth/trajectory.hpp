@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic_trajectory.hpp
+/// \file trajectory.hpp
 /// The chest-mounted camera: mounting (height, tilt, roll), and walking trajectories with bob and
 /// sway, sampled at the frame rate.
 

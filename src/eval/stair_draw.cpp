@@ -1,4 +1,4 @@
-#include "stairguide/stairs/stair_draw.hpp"
+#include "stairguide/eval/stair_draw.hpp"
 
 #include <algorithm>
 #include <cmath>
