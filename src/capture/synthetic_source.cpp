@@ -159,7 +159,7 @@ const std::vector<PresetInfo>& world2_presets() {
 }
 
 const PresetInfo* find_preset_info(const std::string& name) {
-  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets()})
+  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets(), &drop_presets()})
     for (const auto& p : *l)
       if (p.name == name) return &p;
   return nullptr;

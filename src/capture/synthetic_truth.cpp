@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "stairguide/capture/synthetic.hpp"
+#include "synthetic_internal.hpp"
 
 namespace stairguide::synth {
 namespace {
@@ -133,6 +134,7 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
     st.user_step = sp.tread_under(walker.body);
     t.stairs.push_back(std::move(st));
   }
+  detail::drop_truth(scene, walker, ideal, K, o, t);
   return t;
 }
 
