@@ -48,6 +48,8 @@ const char* to_string(Cue c) {
       return "battery_critical";
     case Cue::kSlow:
       return "slow";
+    case Cue::kDropAhead:
+      return "drop_ahead";
   }
   return "?";
 }
@@ -96,6 +98,7 @@ int cue_priority(Cue c) {
     case Cue::kCameraLost:
       return 7;
     case Cue::kDropWarning:
+    case Cue::kDropAhead:
       return 8;
   }
   return 0;
@@ -129,6 +132,11 @@ std::string token(const CueEvent& e) {
       std::snprintf(b, sizeof b, ":%.2fm", static_cast<double>(e.distance_m));
       s += b;
     }
+    return s;
+  }
+  if (e.cue == Cue::kDropAhead) {
+    if (e.number >= 0) s += ":" + std::to_string(e.number) + "m";
+    if (e.clock > 0) s += "@" + std::to_string(e.clock);
     return s;
   }
   if (e.cue == Cue::kStairsAhead || e.cue == Cue::kStepAhead || e.cue == Cue::kDropWarning) {
@@ -230,6 +238,10 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kSlow:
       c = {"slow"};
       break;
+    case Cue::kDropAhead:
+      c = {"warning", "drop_ahead"};
+      distance();
+      break;
   }
   return c;
 }
@@ -240,7 +252,7 @@ const std::vector<std::string>& all_clip_names() {
         "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
         "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
-        "approach", "battery_low", "battery_critical", "slow"};
+        "approach", "battery_low", "battery_critical", "slow", "drop_ahead"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

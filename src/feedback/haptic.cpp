@@ -41,6 +41,8 @@ HapticPattern haptic_pattern(const CueEvent& e) {
       return {{200, 100}, {200, 100}, {200, 100}, {200, 0}};
     case Cue::kSlow:
       return {};  // spoken only
+    case Cue::kDropAhead:
+      return {{150, 60}, {150, 60}, {150, 60}, {150, 0}};  // four strong pulses: unlike any stair cue
   }
   return {};
 }
