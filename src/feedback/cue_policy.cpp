@@ -316,7 +316,7 @@ void CuePolicy::flight_cues(const TraversalResult& tr, double t, std::vector<Cue
 
 void CuePolicy::blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out) {
   const bool tracking = in.traversal.ran && in.traversal.state != TraversalState::kSearching;
-  if (in.floor_found || in.stair.detected || tracking) {
+  if (in.floor_found || in.stair.detected || in.drop.detected || tracking) {
     blind_since_ = -1.0;
     return;
   }

@@ -199,7 +199,8 @@ std::vector<Edge> join_columns(const std::vector<ColumnEdge>& cols, float spacin
     gap = 0;
     if (cur.columns == 0) first = c.xz, cur.nearest = c.xz;
     ++cur.columns;
-    cur.width = std::max(cur.width, (c.xz - first).norm());
+    // Each column stands for a strip one spacing wide: the edge runs half a spacing past its end columns.
+    cur.width = std::max(cur.width, (c.xz - first).norm() + spacing_at_1m * 0.5f * (r + first.norm()));
     if (c.deep) ++cur.deep, cur.depths.push_back(c.depth);
     if (r < cur.nearest.norm()) cur.nearest = c.xz;
     prev = &c;
