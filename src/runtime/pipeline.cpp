@@ -133,6 +133,7 @@ struct PerceptionStage::Impl {
   // only a strip of floor in view, which the floor detector may not take (drop_scene()).
   Pose T_world_floor = Pose::Identity();
   double floor_seen_t = -1.0;
+  std::uint64_t floor_track = 0;  // the odometry's world it is held in
   // Views whose own Manhattan frame waits for the odometry's pose of their frame (oldest first).
   std::deque<std::pair<std::uint64_t, ManhattanSighting>> pending;
 };
@@ -205,19 +206,23 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
 }
 
 // The floor the drop stage measures from: this view's, or, when this view's floor was not found,
-// the one last found carried by the odometry (for at most kFloorCarry s). Standing 0.5-0.7 m from
+// the one last found carried by the odometry (for at most kFloorCarry s, in the same odometry
+// world: a dense odometry drifts about a centimetre in that time). Standing 0.5-0.7 m from
 // a platform's edge, the floor in view is a strip the floor detector does not take, and the
 // approach beep would fall silent where it matters most.
 const SceneResult& PerceptionStage::drop_scene(const RgbdFrame& frame, bool posed_run, SceneResult& carried) {
-  constexpr double kFloorCarry = 3.0;  // s
+  constexpr double kFloorCarry = 8.0;  // s
   Impl& m = *impl_;
   const bool posed = posed_run && m.pose_answer == PoseAnswer::kReady;
   if (m.scene.floor_found) {
     m.floor_seen_t = posed ? frame.timestamp : -1.0;
     if (posed) m.T_world_floor = m.pose_link.T_world_camera * m.scene.T_floor_camera.inverse();
+    m.floor_track = m.pose_link.track;
     return m.scene;
   }
-  if (!posed || m.floor_seen_t < 0.0 || frame.timestamp - m.floor_seen_t > kFloorCarry) return m.scene;
+  if (!posed || m.floor_seen_t < 0.0 || frame.timestamp - m.floor_seen_t > kFloorCarry ||
+      m.pose_link.track != m.floor_track)
+    return m.scene;
   carried.floor_found = true;
   carried.T_floor_camera = m.T_world_floor.inverse() * m.pose_link.T_world_camera;
   return carried;

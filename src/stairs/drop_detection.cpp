@@ -13,8 +13,9 @@ namespace {
 // enough that a ray grazing the edge of a drop deeper than a step has fallen below it (it drops
 // camera-height per distance-to-edge), short enough that the far side of the drop is not asked.
 constexpr float kLookAhead = 0.8f;
-// Samples beyond the edge needed to judge it, and the share of them that must agree.
+// Samples beyond the edge needed to judge it; the first ones seen there (what the rays meet first).
 constexpr int kMinBeyond = 3;
+constexpr int kFirstSeen = 4;
 // m, two columns' edge points farther apart than this (plus their spacing) are two edges.
 constexpr float kJoin = 0.25f;
 // Rays within this of the horizontal never meet the floor within any range: the scan stops there.
@@ -105,17 +106,26 @@ bool judge_beyond(const std::vector<Sample>& col, std::size_t last, const DropCo
   }
   resume = i;
   if (n < kMinBeyond || floor >= 2) return false;
-  int deep = 0, other = 0;
+  int deep = 0, other = 0, classified = 0, first_levels = 0;
   std::vector<float> depths;
   for (std::size_t k = 0; k < beyond.size(); ++k) {
     const float y = beyond[k]->y;
     if (y < -cfg.min_depth) {
       ++deep;
       depths.push_back(-y);
-    } else if (y > 0.f || on_a_level(beyond, k)) {
-      ++other;  // above the floor, or a level within a step below it
+    } else if (y > 0.f) {
+      ++other;  // above the floor: something stands on it
+    } else if (on_a_level(beyond, k)) {
+      ++other;  // a level within a step below it
+      first_levels += classified < kFirstSeen ? 1 : 0;
+    } else {
+      continue;  // a vertical face (the far wall of a hole, flying pixels at the edge)
     }
+    ++classified;
   }
+  // What the rays meet first beyond the edge decides: a level within a step below (the first
+  // tread of a descent, a curb) makes it a step, whatever deeper treads lie further on.
+  if (first_levels >= 2) return false;
   if (deep >= 2 && deep >= 3 * other) {
     out.edge = out.deep = true;
     std::nth_element(depths.begin(), depths.begin() + static_cast<long>(depths.size() / 2), depths.end());
