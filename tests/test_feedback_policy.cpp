@@ -866,4 +866,84 @@ TEST(FeedbackButton, AnswersUseKnownClips) {
         for (const auto& clip : clips_for(e)) EXPECT_TRUE(known(clip)) << token(e) << ": " << clip;
         EXPECT_FALSE(clips_for(e).empty()) << token(e);
       }
+
+// ---- drop-offs (issue 42 item 4) ----
+
+namespace {
+
+// Walking toward a drop's edge at 1 m/s from `from` metres (bearing `bearing`), for `seconds`.
+std::vector<CueInput> drop_walk(double t0, float from, double seconds, float bearing = 0.f) {
+  std::vector<CueInput> f;
+  for (double t = 0.0; t < seconds; t += kDt) {
+    CueInput in = floor_frame(t0 + t);
+    in.drop.detected = true;
+    in.drop.distance_m = std::max(0.3f, from - static_cast<float>(t));
+    in.drop.bearing_rad = bearing;
+    f.push_back(in);
+  }
+  return f;
+}
+
+}  // namespace
+
+// "drop ahead", its distance and clock, once, within danger distance: at every verbosity; with
+// the approach beep after it, quickening; nothing before the drop is confirmed.
+TEST(FeedbackPolicy, DropAheadToldOnceThenBeeps) {
+  for (const char* verbosity : {"quiet", "normal"}) {
+    FeedbackConfig c;
+    c.verbosity = verbosity;
+    CuePolicy p(c);
+    const auto s = feed(p, drop_walk(0.0, 3.5, 3.2, deg2rad(60.f)));
+    std::vector<std::string> said;
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kDropAhead) said.push_back(token(x.e));
+    EXPECT_EQ(said, (std::vector<std::string>{"drop_ahead:2m@2"})) << verbosity;
+    for (const auto& x : s)
+      if (x.e.cue == Cue::kDropAhead) {
+        EXPECT_NEAR(x.t, 1.5, 0.1) << verbosity;  // at 2 m, as the walk crosses danger_distance
+        EXPECT_GT(cue_pan(x.e), 0.5f);            // from the right
+        EXPECT_EQ(clips_for(x.e), (std::vector<std::string>{"warning", "drop_ahead", "n2", "metres", "n2", "oclock"}));
+      }
+  }
+  // Straight ahead: the beeps quicken as the edge nears (the cone is 35 deg).
+  CuePolicy p{FeedbackConfig{}};
+  const auto s = feed(p, drop_walk(0.0, 3.0, 2.8));
+  const auto b = beeps(s);
+  ASSERT_GE(b.size(), 3u);
+  for (std::size_t i = 2; i < b.size(); ++i) EXPECT_LE(b[i] - b[i - 1], b[i - 1] - b[i - 2] + kDt + 1e-6);
+  EXPECT_EQ(count_of(s, Cue::kDropAhead), 1);
+}
+
+// A flicker of the drop stage is never told; a drop forgotten and seen again is told again.
+TEST(FeedbackPolicy, DropFlickerSilentAndForgottenToldAgain) {
+  FeedbackConfig c;
+  CuePolicy p(c);
+  std::vector<CueInput> f;
+  for (int i = 0; i < 60; ++i) {
+    CueInput in = floor_frame(i * kDt);
+    in.drop.detected = i % 10 == 0;  // one frame in ten
+    in.drop.distance_m = 1.5f;
+    f.push_back(in);
+  }
+  EXPECT_EQ(count_of(feed(p, f), Cue::kDropAhead), 0);
+  auto a = drop_walk(2.0, 1.5, 1.0);
+  EXPECT_EQ(count_of(feed(p, a), Cue::kDropAhead), 1);
+  std::vector<CueInput> gap;
+  for (double t = 3.0; t < 3.0 + c.forget_time + 1.0; t += kDt) gap.push_back(floor_frame(t));
+  feed(p, gap);
+  EXPECT_EQ(count_of(feed(p, drop_walk(gap.back().t + kDt, 1.5, 1.0)), Cue::kDropAhead), 1);
+}
+
+// A descending staircase is the stair cue's: a drop the stage reports beside a held descent (or
+// in the same frames) is not told as a drop.
+TEST(FeedbackPolicy, DescentWinsOverADrop) {
+  CuePolicy p{FeedbackConfig{}};
+  auto f = approach(0.0, StairKind::kDescending, 2.5, 2.0);
+  for (auto& in : f) {
+    in.drop.detected = true;
+    in.drop.distance_m = in.stair.distance_m;
+  }
+  const auto s = feed(p, f);
+  EXPECT_EQ(count_of(s, Cue::kDropAhead), 0);
+  EXPECT_EQ(count_of(s, Cue::kDropWarning), 1);
 }

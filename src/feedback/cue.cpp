@@ -56,6 +56,8 @@ const char* to_string(Cue c) {
       return "unmuted";
     case Cue::kVerbosity:
       return "verbosity";
+    case Cue::kDropAhead:
+      return "drop_ahead";
   }
   return "?";
 }
@@ -109,6 +111,7 @@ int cue_priority(Cue c) {
     case Cue::kCameraLost:
       return 7;
     case Cue::kDropWarning:
+    case Cue::kDropAhead:
       return 8;
   }
   return 0;
@@ -142,6 +145,11 @@ std::string token(const CueEvent& e) {
       std::snprintf(b, sizeof b, ":%.2fm", static_cast<double>(e.distance_m));
       s += b;
     }
+    return s;
+  }
+  if (e.cue == Cue::kDropAhead) {
+    if (e.number >= 0) s += ":" + std::to_string(e.number) + "m";
+    if (e.clock > 0) s += "@" + std::to_string(e.clock);
     return s;
   }
   if (e.cue == Cue::kWhere && e.kind == StairKind::kNone && e.clock == 0) {
@@ -298,6 +306,10 @@ std::vector<std::string> clips_for(const CueEvent& e) {
       break;
     default:  // own_clip's
       break;
+    case Cue::kDropAhead:
+      c = {"warning", "drop_ahead"};
+      distance();
+      break;
   }
   return c;
 }
@@ -309,7 +321,7 @@ const std::vector<std::string>& all_clip_names() {
         "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
         "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
         "approach", "battery_low", "battery_critical", "slow",
-        "no_stairs", "muted", "unmuted", "quiet", "normal", "verbose"};
+        "no_stairs", "muted", "unmuted", "quiet", "normal", "verbose", "drop_ahead"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

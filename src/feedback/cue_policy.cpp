@@ -48,6 +48,7 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kCameraBack:
     case Cue::kBlind:
     case Cue::kDropWarning:
+    case Cue::kDropAhead:
     case Cue::kApproach:
     case Cue::kBatteryLow:
     case Cue::kBatteryCritical:
@@ -69,6 +70,7 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
   const double last = last_t_[static_cast<int>(c)];
   switch (c) {
     case Cue::kDropWarning:  // always warns (told once per staircase by the caller)
+    case Cue::kDropAhead:    // ... once per drop held
     case Cue::kCameraLost:
     case Cue::kCameraBack:
     case Cue::kReady:
@@ -120,21 +122,30 @@ float CuePolicy::approach_interval(float d) const {
   return near + (far - near) * (d - cfg_.approach_near) / (cfg_.approach_range - cfg_.approach_near);
 }
 
-void CuePolicy::approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out) {
-  constexpr float kNearer = 0.15f;      // m the wearer must come nearer to count as walking on
-  constexpr float kRangeMargin = 0.25f;  // m beyond the range before a beeping approach stops
-  Approach& a = approach_;
+void CuePolicy::approach_cues(const Sighting& s, const DropSummary& drop, const TraversalResult& tr, double t,
+                              std::vector<CueEvent>& out) {
   const bool stepped_on = tr.ran && (on_flight(tr.state) || tr.state == TraversalState::kArrived);
   const bool descent_held = told_.active && told_.key == -1;
-  if (cfg_.approach_range <= 0.f || stepped_on || !descent_held) {
-    a = Approach{};
+  const bool drop_held = drop_.active && !descent_held;
+  if (cfg_.approach_range <= 0.f || stepped_on || !(descent_held || drop_held)) {
+    approach_ = Approach{};
     return;
   }
   // A frame without a sighting of it (a dropout) neither beeps nor ends the approach: it ends
-  // when the staircase is forgotten (above).
-  if (!s.present || key_of(s.kind, s.direction) != -1 || !std::isfinite(s.distance_m)) return;
-  const float d = s.distance_m;
-  const bool ahead = !std::isfinite(s.bearing_rad) || std::fabs(s.bearing_rad) <= cfg_.approach_cone;
+  // when the staircase (or the drop) is forgotten (above).
+  if (descent_held) {
+    if (!s.present || key_of(s.kind, s.direction) != -1 || !std::isfinite(s.distance_m)) return;
+    approach_beat(s.distance_m, s.bearing_rad, t, out);
+  } else if (drop.detected && std::isfinite(drop.distance_m)) {
+    approach_beat(drop.distance_m, drop.bearing_rad, t, out);
+  }
+}
+
+void CuePolicy::approach_beat(float d, float bearing, double t, std::vector<CueEvent>& out) {
+  constexpr float kNearer = 0.15f;      // m the wearer must come nearer to count as walking on
+  constexpr float kRangeMargin = 0.25f;  // m beyond the range before a beeping approach stops
+  Approach& a = approach_;
+  const bool ahead = !std::isfinite(bearing) || std::fabs(bearing) <= cfg_.approach_cone;
   if (!ahead) {
     a = Approach{};  // turned away: facing it again starts a new approach
     return;
@@ -164,18 +175,50 @@ void CuePolicy::approach_cues(const Sighting& s, const TraversalResult& tr, doub
   }
   a.nearest = std::min(a.nearest, filtered);
   if (t - a.ref_t > cfg_.approach_stall) return;  // stopped: silent until walking on
-  // The drop warning is a beat of its own (a beep over its alarm would blur both): the next beep
-  // keeps the interval from it.
-  a.last_beep_t = std::max(a.last_beep_t, last_t_[static_cast<int>(Cue::kDropWarning)]);
+  // The drop warnings are beats of their own (a beep over their alarm would blur both): the next
+  // beep keeps the interval from them.
+  a.last_beep_t = std::max({a.last_beep_t, last_t_[static_cast<int>(Cue::kDropWarning)],
+                            last_t_[static_cast<int>(Cue::kDropAhead)]});
   if (t - a.last_beep_t + 1e-6 < approach_interval(a.nearest)) return;
   a.last_beep_t = t;
   CueEvent e;
   e.cue = Cue::kApproach;
   e.direction = -1;
   e.kind = StairKind::kDescending;
-  e.bearing_rad = s.bearing_rad;
+  e.bearing_rad = bearing;
   e.distance_m = a.nearest;
   emit(out, e, t);
+}
+
+// A drop-off is confirmed as a staircase is, held until unseen for forget_time, and told once while
+// held when within danger_distance; never while a descent is held or seen (the stair cue wins).
+void CuePolicy::drop_cues(const DropSummary& drop, bool descent, double t, std::vector<CueEvent>& out) {
+  DropHold& h = drop_;
+  if (h.active && t - h.last_seen_t > cfg_.forget_time) h = DropHold{};
+  if (!drop.detected) {
+    if (!h.active && t - h.last_t > cfg_.confirm_time) h.frames = 0;
+    return;
+  }
+  if (!h.active) {
+    if (h.frames > 0 && t - h.last_t > cfg_.confirm_time) h.frames = 0;  // a gap: start again
+    if (h.frames == 0) h.first_t = t;
+    ++h.frames;
+    h.last_t = t;
+    if (h.frames < cfg_.confirm_frames || t - h.first_t < cfg_.confirm_time - 1e-6) return;
+    h.active = true;
+  }
+  h.last_seen_t = t;
+  const bool near = !std::isfinite(drop.distance_m) || drop.distance_m <= cfg_.danger_distance;
+  if (h.warned || !near || descent) return;
+  CueEvent e;
+  e.cue = Cue::kDropAhead;
+  e.direction = -1;
+  e.number = metres_of(drop.distance_m);
+  const int c = clock_position(drop.bearing_rad);
+  e.clock = c == 12 && verbosity_ != Verbosity::kVerbose ? 0 : c;
+  e.bearing_rad = drop.bearing_rad;
+  emit(out, e, t);
+  h.warned = true;
 }
 
 void CuePolicy::detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out) {
@@ -281,7 +324,7 @@ void CuePolicy::flight_cues(const TraversalResult& tr, double t, std::vector<Cue
 
 void CuePolicy::blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out) {
   const bool tracking = in.traversal.ran && in.traversal.state != TraversalState::kSearching;
-  if (in.floor_found || in.stair.detected || tracking) {
+  if (in.floor_found || in.stair.detected || in.drop.detected || tracking) {
     blind_since_ = -1.0;
     return;
   }
@@ -307,6 +350,7 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     slow_since_ = -1.0;
     approach_ = Approach{};
     if (mute_until_ >= 0.0) mute_until_ = t + std::max(0.0, mute_until_ - last_frame_t_);  // what was left of it
+    drop_ = DropHold{};
   }
   last_frame_t_ = t;
   if (!ready_told_) {
@@ -330,7 +374,9 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     flight_left_ = tr.steps_left;
     flight_dir_ = tr.direction;
   }
-  approach_cues(s, tr, t, out);
+  const bool descent = (told_.active && told_.key < 0) || (s.present && key_of(s.kind, s.direction) < 0);
+  drop_cues(in.drop, descent, t, out);
+  approach_cues(s, in.drop, tr, t, out);
   if (tr.ran) flight_cues(tr, t, out);
   blind_cues(in, t, out);
   // Perception behind the camera for long enough that what is told comes late.
@@ -367,12 +413,13 @@ void CuePolicy::mute_filter(std::vector<CueEvent>& out, double t) {
     emit(out, e, t);
     return;
   }
-  // A descent's warnings are never muted (the wearer may be walking towards the edge), nor the
-  // answers to the button (asked for).
+  // A descent's or a drop's warnings are never muted (the wearer may be walking towards the edge),
+  // nor the answers to the button (asked for).
   out.erase(std::remove_if(out.begin(), out.end(),
                            [](const CueEvent& e) {
                              switch (e.cue) {
                                case Cue::kDropWarning:
+                               case Cue::kDropAhead:
                                case Cue::kApproach:
                                case Cue::kWhere:
                                case Cue::kMuted:

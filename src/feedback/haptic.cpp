@@ -47,6 +47,8 @@ HapticPattern haptic_pattern(const CueEvent& e) {
       return {{40, 60}, {40, 60}, {40, 60}, {40, 0}};  // a flutter: sound off
     case Cue::kUnmuted:
       return {{150, 0}};  // as ready: sound on again
+    case Cue::kDropAhead:
+      return {{150, 60}, {150, 60}, {150, 60}, {150, 0}};  // four strong pulses: unlike any stair cue
   }
   return {};
 }

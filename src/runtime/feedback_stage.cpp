@@ -304,6 +304,7 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   in.t = timestamp_s;
   in.floor_found = perception.floor_found;
   in.stair = perception.stair;
+  in.drop = perception.drop;
   in.traversal = perception.traversal;
   const auto now = SteadyClock::now();
   in.lag_s = std::max(0.0, std::chrono::duration<double>(now - captured).count());

@@ -13,6 +13,7 @@
 
 #include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/drop_detection.hpp"
 #include "stairguide/stairs/stairs.hpp"
 #include "stairguide/stairs/traversal.hpp"
 
@@ -128,6 +129,11 @@ struct PerceptionStage::Impl {
   // The odometry's answer for the frame being perceived (hold_and_carry asks it).
   PoseAnswer pose_answer = PoseAnswer::kNever;
   OdometryLink pose_link;
+  // The floor as last found, held in the odometry's world: a drop's edge near the feet leaves
+  // only a strip of floor in view, which the floor detector may not take (drop_scene()).
+  Pose T_world_floor = Pose::Identity();
+  double floor_seen_t = -1.0;
+  std::uint64_t floor_track = 0;  // the odometry's world it is held in
   // Views whose own Manhattan frame waits for the odometry's pose of their frame (oldest first).
   std::deque<std::pair<std::uint64_t, ManhattanSighting>> pending;
 };
@@ -156,6 +162,10 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   m.stairs.run(m.scene, &frame.intrinsics, m.stair);
   out.stair_detected = m.stair.detected;
   out.stair = summarize(m.stair);
+  // Drop-offs: the floor ending with nothing within a step below (a descent is the stair stage's).
+  SceneResult carried;
+  const DropResult drop = detect_drop(frame, drop_scene(frame, static_cast<bool>(odometry), carried), m.config.drops);
+  out.drop = summarize_drop(drop, m.stair);
   // The tracker: the pose of this frame when the odometry has it; otherwise the tracker takes the
   // camera to be where it was and lets the live view correct the staircase.
   if (m.config.traversal.enabled) {
@@ -185,8 +195,37 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
     out.state = "floor";
     out.detail = std::string("floor, no stairs: ") + to_string(m.stair.verdict);
   }
+  if (out.drop.detected) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "; drop ahead %.2f m at %+.0f deg, %.2f m deep", out.drop.distance_m,
+                  rad2deg(out.drop.bearing_rad), out.drop.depth_m);
+    out.detail += buf;
+  }
   out.ms = ms_since(t0);
   return out;
+}
+
+// The floor the drop stage measures from: this view's, or, when this view's floor was not found,
+// the one last found carried by the odometry (for at most kFloorCarry s, in the same odometry
+// world: a dense odometry drifts about a centimetre in that time). Standing 0.5-0.7 m from
+// a platform's edge, the floor in view is a strip the floor detector does not take, and the
+// approach beep would fall silent where it matters most.
+const SceneResult& PerceptionStage::drop_scene(const RgbdFrame& frame, bool posed_run, SceneResult& carried) {
+  constexpr double kFloorCarry = 8.0;  // s
+  Impl& m = *impl_;
+  const bool posed = posed_run && m.pose_answer == PoseAnswer::kReady;
+  if (m.scene.floor_found) {
+    m.floor_seen_t = posed ? frame.timestamp : -1.0;
+    if (posed) m.T_world_floor = m.pose_link.T_world_camera * m.scene.T_floor_camera.inverse();
+    m.floor_track = m.pose_link.track;
+    return m.scene;
+  }
+  if (!posed || m.floor_seen_t < 0.0 || frame.timestamp - m.floor_seen_t > kFloorCarry ||
+      m.pose_link.track != m.floor_track)
+    return m.scene;
+  carried.floor_found = true;
+  carried.T_floor_camera = m.T_world_floor.inverse() * m.pose_link.T_world_camera;
+  return carried;
 }
 
 // The odometry's pose is asked for only now: running beside perception on the same frame, it has

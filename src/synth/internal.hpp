@@ -55,6 +55,11 @@ const std::vector<PresetDef>& walk_defs();
 const std::vector<PresetDef>& rig_defs();
 /// The second world (synth.hpp: world2_presets()), in world2.cpp.
 const std::vector<PresetDef>& world2_defs();
+/// The drop-offs (issue 42 item 4), in synthetic_drops.cpp; and their ground truth (FrameTruth's
+/// drop_* fields) from the scene's drop edges and the ideal render.
+const std::vector<PresetDef>& drop_defs();
+void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal, const CameraIntrinsics& K,
+                const SynthOptions& o, FrameTruth& t);
 // nullptr when unknown.
 const PresetDef* find_preset(const std::string& name);
 std::uint64_t name_hash(const std::string& s);

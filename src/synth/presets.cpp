@@ -561,6 +561,8 @@ const PresetDef* find_preset(const std::string& name) {
     if (d.info.name == name) return &d;
   for (const auto& d : world2_defs())
     if (d.info.name == name) return &d;
+  for (const auto& d : drop_defs())
+    if (d.info.name == name) return &d;
   return nullptr;
 }
 

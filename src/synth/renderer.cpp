@@ -45,6 +45,7 @@ const detail::PresetDef& need_preset(const std::string& name) {
     for (const auto& p : detail::walk_defs()) known += ", " + p.info.name;
     for (const auto& p : detail::rig_defs()) known += ", " + p.info.name;
     for (const auto& p : detail::world2_defs()) known += ", " + p.info.name;
+    for (const auto& p : detail::drop_defs()) known += ", " + p.info.name;
     throw SourceError("synthetic source: unknown scene '" + name + "' (known: " + known + ")");
   }
   return *d;
@@ -104,7 +105,7 @@ const std::vector<PresetInfo>& world2_presets() {
 }
 
 const PresetInfo* find_preset_info(const std::string& name) {
-  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets()})
+  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets(), &drop_presets()})
     for (const auto& p : *l)
       if (p.name == name) return &p;
   return nullptr;

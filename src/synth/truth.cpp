@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "internal.hpp"
 #include "stairguide/synth/synth.hpp"
 
 namespace stairguide::synth {
@@ -133,6 +134,7 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
     st.user_step = sp.tread_under(walker.body);
     t.stairs.push_back(std::move(st));
   }
+  detail::drop_truth(scene, walker, ideal, K, o, t);
   return t;
 }
 

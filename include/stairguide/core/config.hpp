@@ -412,6 +412,26 @@ struct TraversalConfig {
   }
 };
 
+/// Drop-offs (stairs/drop_detection.hpp, issue 42 item 4): the floor ending at an edge with
+/// nothing within a step below it.
+struct DropConfig {
+  bool enabled = true;         ///< look for drop-offs
+  float min_depth = 0.25f;     ///< m, a level this far below the floor is a drop (deeper than any step: 25 cm)
+  float max_distance = 4.0f;   ///< m, edges farther than this along the floor are not reported
+  float sensor_range = 4.0f;   ///< m, no reading where the floor, continued, would lie nearer than this extends a drop's edge
+  float min_width = 0.3f;      ///< m, an edge shorter than this is no drop (a drain, a gap in the readings)
+
+  template <class V> void visit(V& v) {
+    v.flag(enabled, "enabled", "look for drop-offs: the floor ending at an edge with nothing within a step below it");
+    v.num(min_depth, "min_depth_cm", Unit::kCentimetre, 15, 100,
+          "a surface seen this far below the floor beyond its edge is a drop (deeper than a step)");
+    v.num(max_distance, "max_distance_m", Unit::kMetre, 1, 8, "drop edges farther than this along the floor are not reported");
+    v.num(sensor_range, "sensor_range_m", Unit::kMetre, 1, 10,
+          "the depth sensor reads a floor this far: beyond an edge, no reading where the floor would be nearer extends the drop");
+    v.num(min_width, "min_width_cm", Unit::kCentimetre, 10, 200, "a drop edge shorter than this is not reported");
+  }
+};
+
 struct OdometryConfig {
   float sigma_intensity = 5.0f;     ///< intensity units (0-255), photometric residual scale
   float sigma_inv_depth = 0.0025f;  ///< 1/m, inverse-depth residual scale
@@ -576,6 +596,7 @@ struct PipelineConfig {
   StairDetectionConfig stair_detection;
   StairModellingConfig stair_modelling;
   TraversalConfig traversal;
+  DropConfig drops;
   OdometryConfig odometry;
   RuntimeConfig runtime;
   FeedbackConfig feedback;
@@ -589,6 +610,7 @@ struct PipelineConfig {
     v.section("stair_detection", "stair detection (paper 4.1)", stair_detection);
     v.section("stair_modelling", "stair modelling and validation (paper 4.2)", stair_modelling);
     v.section("traversal", "stair traversal: the step the user is on, steps left (paper 5.2)", traversal);
+    v.section("drops", "drop-offs: platform edges, docks, holes, sunken floors (issue 42)", drops);
     v.section("odometry", "dense RGB-D visual odometry (paper 5.1)", odometry);
     v.section("runtime", "daemon threads, logging and counters", runtime);
     v.section("feedback", "audio cues and haptic buzzer", feedback);

@@ -10,6 +10,7 @@
 ///  - descending: the edge where the floor ends and the first drop begins (height 0);
 ///  - single step / curb: the edge of the raised (or lowered) surface nearest the user.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,16 @@ struct FrameTruth {
   /// per-frame pose, so T_world_camera and every T_camera_stair are unknown and a detection is
   /// scored by its direction (and by riser and tread where the label gives them), not its place.
   bool pose_known = true;
+  /// A drop-off (the floor ends at an edge with nothing within a step below it: a platform edge,
+  /// a dock, a hole, a sunken floor; issue 42 item 4) is in view: at least 0.3 m of its edge is
+  /// seen, unoccluded and in range, with the floor before it. Distance (m, along the floor from
+  /// the point under the camera) and bearing (rad, from the camera's forward direction, positive
+  /// to the right) of the nearest point of the edge in view; NaN when none. drop_depth_m: how far
+  /// the level beyond it lies below the floor (0 without a drop in the scene).
+  bool drop_in_view = false;
+  float drop_distance_m = std::numeric_limits<float>::quiet_NaN();
+  float drop_bearing_rad = std::numeric_limits<float>::quiet_NaN();
+  float drop_depth_m = 0.f;
 
   /// Staircases with at least one visible step or a visible first edge.
   bool any_stair_visible() const;

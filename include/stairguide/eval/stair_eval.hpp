@@ -34,6 +34,7 @@
 
 #include "stairguide/core/ground_truth.hpp"
 #include "stairguide/stairs/stair_result.hpp"
+#include "stairguide/stairs/traversal_result.hpp"
 
 namespace stairguide {
 
@@ -130,6 +131,30 @@ struct StairEvalTable {
   std::string to_json() const;
   /// A human-readable table.
   std::string to_text() const;
+};
+
+/// Drop-offs (issue 42 item 4) told per frame, scored against the synthetic truth's drop_* fields.
+struct DropEvalSummary {
+  int frames = 0;
+  int near = 0, near_told = 0;        ///< a drop in view within DropEvalTable::near_m, and of them told
+  int near_no_floor = 0;              ///< ... of the near ones missed, those where perception found no floor
+  int far = 0, far_told = 0;          ///< a drop in view beyond it (within reach of the sensor or not)
+  int none = 0, none_told = 0;        ///< no drop in the scene (and no descent in view): told is a false alarm
+  int hidden = 0, hidden_told = 0;    ///< a drop in the scene but too little of its edge in view
+  /// A descending staircase (or step down) in view: told as a drop; a drop found there that the
+  /// stair cue took over (DropSummary::by_stairs).
+  int descent = 0, descent_told = 0, descent_by_stairs = 0;
+  ErrorStats distance, bearing_deg;   ///< of the near frames told: m and deg, told minus truth
+  double near_rate() const { return near ? static_cast<double>(near_told) / near : 1.0; }
+};
+
+struct DropEvalTable {
+  float near_m = 2.f;  ///< m, the edge within this of the wearer: must be told
+  DropEvalSummary all;
+  std::map<std::string, DropEvalSummary> by_scene;
+  void add(const DropSummary& told, const FrameTruth& truth, const std::string& scene, bool floor_found = true);
+  std::string to_json() const;  ///< one object: the overall counts and by_scene
+  std::string to_text() const;  ///< a table, one line per scene with any frame of interest
 };
 
 }  // namespace stairguide

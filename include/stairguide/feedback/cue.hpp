@@ -38,10 +38,11 @@ enum class Cue {
   kMuted,      ///< long press: the cues are muted for `number` s (a descent still warns)
   kUnmuted,    ///< the mute is over (its time, or another long press)
   kVerbosity,  ///< double press: the verbosity is now `number` (0 quiet, 1 normal, 2 verbose)
+  kDropAhead,  ///< a drop-off (platform edge, dock, hole) near, `number` metres, `clock`: always told
 };
 
 /// Number of Cue values (for tables indexed by cue).
-constexpr int kCueKinds = static_cast<int>(Cue::kVerbosity) + 1;
+constexpr int kCueKinds = static_cast<int>(Cue::kDropAhead) + 1;
 
 /// Whether the cue marks a step of a flight (first step, tick, count, steps left, last step, end
 /// of stairs): its moment passes with the next step, after which it must not be heard.
@@ -49,7 +50,7 @@ bool marks_a_step(Cue c);
 
 /// "ready", "camera_lost", "camera_back", "blind", "stairs_ahead", "drop_warning", "step_ahead",
 /// "first_step", "tick", "count", "steps_left", "last_step", "end_of_stairs", "approach",
-/// "battery_low", "battery_critical", "slow", "where", "muted", "unmuted", "verbosity".
+/// "battery_low", "battery_critical", "slow", "where", "muted", "unmuted", "verbosity", "drop_ahead".
 const char* to_string(Cue c);
 
 /// Higher interrupts lower: a warning cuts a tick. Fixed per cue (see cue.cpp for the order).
@@ -66,7 +67,7 @@ struct CueEvent {
   /// rad, bearing of the staircase the cue is about (positive to the right); NaN: not placed
   /// (system cues, and the flight's cues: the staircase is under the feet).
   float bearing_rad = std::numeric_limits<float>::quiet_NaN();
-  /// m, the distance to the first edge (kApproach); NaN otherwise.
+  /// m, the distance to the first edge or the drop's edge (kApproach); NaN otherwise.
   float distance_m = std::numeric_limits<float>::quiet_NaN();
 };
 

@@ -24,6 +24,11 @@
 ///   not come 0.15 m nearer for `approach_stall` s (stopped; it resumes on walking on), and when
 ///   the staircase is forgotten. At every verbosity. The drop warning counts as a beat (no beep over
 ///   its alarm; the next beep keeps the interval from it).
+/// - A drop-off (platform edge, dock, hole) confirmed as a staircase is (`confirm_frames` over
+///   `confirm_time`) and within `danger_distance` m is told once while it is held ("drop ahead",
+///   distance, clock), at every verbosity, again when it comes back after being forgotten
+///   (`forget_time`). Never while a descending staircase is held or seen: the stair cue wins. The
+///   approach beep runs for a held drop's edge as for a descent's first edge.
 /// - While the traversal tracker runs (`traversal.ran`), the flight cues (first step, ticks, counts,
 ///   steps left, last step, end) follow its states; without it only the detection cues are given.
 ///
@@ -64,6 +69,7 @@ struct CueInput {
   bool floor_found = false;   ///< the floor is seen in this frame
   StairSummary stair;         ///< this frame's detection
   TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
+  DropSummary drop;           ///< this frame's drop-off (not told when the stair stage tells a descent)
   double lag_s = 0.0;         ///< s from the frame's capture to this decision (perception behind)
   std::vector<Press> presses;  ///< the wearer's button presses since the last decision, in order
 };
@@ -124,7 +130,10 @@ class CuePolicy {
   void detection_cues(const Sighting& s, double t, std::vector<CueEvent>& out);
   void flight_cues(const TraversalResult& tr, double t, std::vector<CueEvent>& out);
   void blind_cues(const CueInput& in, double t, std::vector<CueEvent>& out);
-  void approach_cues(const Sighting& s, const TraversalResult& tr, double t, std::vector<CueEvent>& out);
+  void approach_cues(const Sighting& s, const DropSummary& drop, const TraversalResult& tr, double t,
+                     std::vector<CueEvent>& out);
+  void approach_beat(float d, float bearing, double t, std::vector<CueEvent>& out);
+  void drop_cues(const DropSummary& drop, bool descent, double t, std::vector<CueEvent>& out);
   float approach_interval(float d) const;
   void button_cues(const std::vector<Press>& presses, double t, std::vector<CueEvent>& out);
   CueEvent where_event(double t) const;
@@ -153,6 +162,14 @@ class CuePolicy {
     int n_recent = 0;
   };
   Approach approach_;
+  // A drop-off: confirmed (as a staircase is), held until forgotten, warned of once while held.
+  struct DropHold {
+    bool active = false, warned = false;
+    int frames = 0;                   // confirming sightings
+    double first_t = 0.0, last_t = -1e9;  // of the candidate's sightings
+    double last_seen_t = -1e9;
+  };
+  DropHold drop_;
   // Blind.
   double blind_since_ = -1.0;
   double last_blind_t_ = -1e9;

@@ -5,7 +5,7 @@
 ///
 /// - `OdometryStage::step(frame)`: dense RGB-D odometry on every frame (odometry room).
 /// - `PerceptionStage::step(frame, odometry)`: segmentation, floor, Manhattan frame, classification
-///   (perception room) -> stair detection and modelling (stairs room) -> traversal.
+///   (perception room) -> stair detection and modelling, drop-offs (stairs room) -> traversal.
 /// - `FeedbackStage::decide(perception, odometry)`: the cue decision (feedback room).
 ///
 /// Each stage wraps whatever the library provides; a room the library does not have yet is
@@ -64,6 +64,7 @@ struct PerceptionOutput {
   int rig_learned = 0;  ///< FloorDetector::rig_learned(): changes when the rig is learned anew
   /// The typed results: what the feedback room reads (as numbers, not from `detail`).
   StairSummary stair;
+  DropSummary drop;           ///< a drop-off ahead (stairs/drop_detection.hpp); not told when `stair` goes down
   TraversalResult traversal;  ///< the traversal tracker (stairs/traversal.hpp); `ran` false when traversal.enabled is off
   double ms = 0.0;     ///< time spent in the stages
 };
@@ -132,6 +133,7 @@ class PerceptionStage {
 
  private:
   void hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry);
+  const SceneResult& drop_scene(const RgbdFrame& frame, bool posed_run, SceneResult& carried);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -31,6 +31,18 @@ struct StairSummary {
   bool has_distance() const { return std::isfinite(distance_m); }
 };
 
+/// One frame's drop-off (stairs/drop_detection.hpp), reduced to what the user is told. A drop found
+/// in a frame where the stair stage finds a staircase or step going down is not told as a drop:
+/// the stair cue wins (`by_stairs`).
+struct DropSummary {
+  bool detected = false;
+  bool by_stairs = false;  ///< a drop edge was found, but the stair stage tells a descent here
+  /// m along the floor to the nearest point of the edge, rad its bearing (positive right); NaN none.
+  float distance_m = std::numeric_limits<float>::quiet_NaN();
+  float bearing_rad = std::numeric_limits<float>::quiet_NaN();
+  float depth_m = std::numeric_limits<float>::quiet_NaN();  ///< m below the floor, as seen
+};
+
 /// Where the user is with respect to a staircase (paper 5.2).
 enum class TraversalState {
   kSearching,  ///< no staircase ahead: detection and modelling run as usual

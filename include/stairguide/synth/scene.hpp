@@ -83,6 +83,14 @@ struct StairSpec {
   int tread_under(const Eigen::Vector3f& p_world) const;
 };
 
+/// The edge of a drop-off (issue 42 item 4): the floor ends along the segment a-b (world) and the
+/// level beyond lies `depth_m` below it, on the side `down_dir` (a horizontal unit vector) points to.
+struct DropEdge {
+  Eigen::Vector3f a = Eigen::Vector3f::Zero(), b = Eigen::Vector3f::Zero();
+  Eigen::Vector3f down_dir = Eigen::Vector3f::UnitX();
+  float depth_m = 0.f;
+};
+
 /// A scene: solids (with their faces, built on insertion), staircases and lighting.
 class Scene {
  public:
@@ -104,6 +112,7 @@ class Scene {
 
   std::string name;
   std::vector<StairSpec> stairs;
+  std::vector<DropEdge> drops;  ///< drop-off edges (synthetic_drops.cpp), for the ground truth
   Eigen::Vector3f light_dir{0.35f, 0.25f, 0.90f};  ///< world, towards the light (normalised on use)
   float ambient = 0.35f;                           ///< fraction of light that is ambient
 

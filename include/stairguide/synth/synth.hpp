@@ -53,6 +53,10 @@ const std::vector<PresetInfo>& rig_presets();
 /// (docs/synthetic.md), never from what the detector accepts. Kept out of presets() and
 /// world_presets() so the suites that run those keep their figures.
 const std::vector<PresetInfo>& world2_presets();
+/// Drop-offs (issue 42 item 4): a platform edge, a loading dock, a hole, a sunken floor (static
+/// views) and a walk towards a platform edge; FrameTruth's drop_* fields label them. Kept out of
+/// the other lists so the suites that run those keep their figures.
+const std::vector<PresetInfo>& drop_presets();
 /// A preset or walk by name; nullptr when there is none.
 const PresetInfo* find_preset_info(const std::string& name);
 

@@ -15,6 +15,7 @@
 #include "stairguide/synth/synth.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/eval/stair_eval.hpp"
+#include "stairguide/stairs/drop_detection.hpp"
 #include "stairguide/stairs/stairs.hpp"
 
 namespace fs = std::filesystem;
@@ -28,6 +29,8 @@ bool is_static_preset(const std::string& name) {
   for (const auto& p : synth::world_presets())
     if (p.name == name) return p.default_frames == 1;
   for (const auto& p : synth::world2_presets())
+    if (p.name == name) return p.default_frames == 1;
+  for (const auto& p : synth::drop_presets())
     if (p.name == name) return p.default_frames == 1;
   return false;
 }
@@ -64,10 +67,12 @@ struct Runner {
   SceneResult scene;
   StairResult result;
   StairEvalTable table;
+  DropConfig drop_config;
+  DropEvalTable drops;  // the drop stage as the runtime's perception stage runs it (pipeline.cpp)
   bool progress = isatty(2) != 0;
   bool verbose = false;
   long index = 0;
-  explicit Runner(const PipelineConfig& c) : perception(c), stage(c) {}
+  explicit Runner(const PipelineConfig& c) : perception(c), stage(c), drop_config(c.drops) {}
 
   void frame(const RgbdFrame& f, const FrameTruth& truth, bool independent, const StairEvalOptions& opt,
              const std::string& scene_name) {
@@ -76,6 +81,9 @@ struct Runner {
     stage.run(scene, f.intrinsics, result);
     const StairFrameEval e = evaluate_stair_frame(result, truth, opt);
     table.add(e, scene_name);
+    const DropResult drop = detect_drop(f, scene, drop_config);
+    const DropSummary told = summarize_drop(drop, result);
+    drops.add(told, truth, scene_name, scene.floor_found);
     if (verbose) {
       std::printf("%-28s %5lu %-8s truth %-11s (%2d treads) got %-11s %2d levels  %s", scene_name.c_str(),
                   static_cast<unsigned long>(truth.index), to_string(e.outcome), to_string(e.truth_kind),
@@ -91,6 +99,10 @@ struct Runner {
                     100 * result.riser_m, 100 * result.tread_m, 100 * result.width_m,
                     scene.floor_found ? (scene.floor_tracked ? "tracked" : "found") : "none",
                     scene.floor_found ? scene.camera_height : 0.f, truth.camera_height_m);
+      if (told.detected || truth.drop_in_view)
+        std::printf("  drop: truth %s %.2f m %+.0f deg, got %s %.2f m %+.0f deg (%s)", truth.drop_in_view ? "yes" : "no",
+                    truth.drop_distance_m, rad2deg(truth.drop_bearing_rad), told.detected ? "yes" : "no",
+                    told.distance_m, rad2deg(told.bearing_rad), to_string(drop.verdict));
       std::printf("\n");
     }
     ++index;
@@ -231,10 +243,14 @@ int eval(Context& ctx) {
       }
     }
   }
-  if (json)
-    std::printf("%s\n", run.table.to_json().c_str());
-  else
+  if (json) {
+    std::string o = run.table.to_json();
+    o.pop_back();  // the stairs' object, with the drops' added to it
+    std::printf("%s, \"drops\": %s}\n", o.c_str(), run.drops.to_json().c_str());
+  } else {
     std::fputs(run.table.to_text().c_str(), stdout);
+    std::fputs(run.drops.to_text().c_str(), stdout);
+  }
   return 0;
 }
 

@@ -24,7 +24,7 @@ int synth_cmd(Context& ctx) {
   ctx.positionals(0, 0);
   if (list) {
     for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(), &synth::rig_presets(),
-                             &synth::world2_presets()})
+                             &synth::world2_presets(), &synth::drop_presets()})
       for (const auto& p : *l) std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
     return 0;
   }
@@ -34,7 +34,7 @@ int synth_cmd(Context& ctx) {
   if (!preset) {
     std::string names;
     for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(), &synth::rig_presets(),
-                             &synth::world2_presets()})
+                             &synth::world2_presets(), &synth::drop_presets()})
       for (const auto& p : *l) names += (names.empty() ? "" : ", ") + p.name;
     throw UsageError("unknown scene '" + *scene + "' (known: " + names + ")");
   }
