@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "feedback_test_util.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 
 namespace fs = std::filesystem;
 

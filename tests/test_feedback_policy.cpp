@@ -866,6 +866,7 @@ TEST(FeedbackButton, AnswersUseKnownClips) {
         for (const auto& clip : clips_for(e)) EXPECT_TRUE(known(clip)) << token(e) << ": " << clip;
         EXPECT_FALSE(clips_for(e).empty()) << token(e);
       }
+}
 
 // ---- drop-offs (issue 42 item 4) ----
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic.hpp"
+#include "stairguide/synth/synth.hpp"
 #include "stairguide/stairs/drop_detection.hpp"
 #include "synth_stairs_test_util.hpp"
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "stairguide/core/json.hpp"
-#include "stairguide/stairs/stair_eval.hpp"
+#include "stairguide/eval/stair_eval.hpp"
 
 namespace stairguide {
 
