@@ -274,8 +274,13 @@ int FloorlessStairs::split_at_landing() {
   bool up_ok = true, down_ok = true;
   for (int k = u + 1; k < n; ++k) up_ok = up_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k - 1)] + kMinRise;
   for (int k = u - 1; k >= 0; --k) down_ok = down_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k + 1)] + kMinRise;
-  if (!up_ok && !down_ok) return 0;
+  // Two levels beyond the landing at least: one pair is no evidence (at the foot of a short climb
+  // the floor strip seen in a corner lies farther than the first tread, and the landing farther
+  // again: the first tread came nearest, and a flight "down" to the floor strip was told).
   const int up_levels = n - u, down_levels = u + 1;
+  up_ok = up_ok && up_levels >= 3;
+  down_ok = down_ok && down_levels >= 3;
+  if (!up_ok && !down_ok) return 0;
   const bool up = up_ok && (!down_ok || up_levels > down_levels);
   const std::size_t first = up ? static_cast<std::size_t>(u) : 0, last = up ? chain_.size() : static_cast<std::size_t>(u) + 1;
   chain_.assign(chain_.begin() + static_cast<long>(first), chain_.begin() + static_cast<long>(last));
