@@ -43,8 +43,7 @@ Pose edge_frame(const V3& origin, float psi) {
   return T;
 }
 
-// A straight edge of E from y0 to y1 (x_E = x), the drop on the side `dir` (+1: +x_E) or along
-// y_E (`along_y`).
+// The edge a-b (in E) labelled: the lower level `depth` below, on the side `down_in_e` points to.
 void label_edge(Scene& s, const Pose& E, const V3& a, const V3& b, const V3& down_in_e, float depth) {
   DropEdge d;
   d.a = E * a;
@@ -84,12 +83,11 @@ void clutter_before(Scene& s, Rng& rng, const Pose& E, float reach) {
 
 // The upper floor (x_E < 0) standing `depth` above a lower ground (x_E > 0, `lower_far` m
 // deep), both `half` m either side of the origin along the edge; the edge labelled.
-void two_levels(Scene& s, Rng& rng, const Pose& E, float depth, float half, float lower_far, const Material& top,
+void two_levels(Scene& s, const Pose& E, float depth, float half, float lower_far, const Material& top,
                 const Material& low) {
   s.add_box_in(E, V3(-14.f, -half, -depth - 0.3f), V3(0.f, half, 0.f), top, "floor");
   s.add_box_in(E, V3(0.f, -half, -depth - 0.3f), V3(lower_far, half, -depth), low, "lower_floor");
   label_edge(s, E, V3(0.f, -half, 0.f), V3(0.f, half, 0.f), V3::UnitX(), depth);
-  (void)rng;
 }
 
 // A railway or tram platform: the track bed 0.55-1.3 m below, two rails, the opposite platform
@@ -99,7 +97,7 @@ void platform_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float H = rng.uniform(0.55f, 1.3f), gap = rng.uniform(4.f, 7.f);
   Material bed = concrete_material(rng);
   bed.albedo *= rng.uniform(0.5f, 0.9f);  // ballast and sleepers: darker than the platform
-  two_levels(b.scene, rng, E, H, 30.f, gap, concrete_material(rng), bed);
+  two_levels(b.scene, E, H, 30.f, gap, concrete_material(rng), bed);
   const float r0 = rng.uniform(1.0f, 1.6f);
   for (float x : {r0, r0 + 1.435f})  // standard gauge
     b.scene.add_box_in(E, V3(x - 0.035f, -30.f, -H), V3(x + 0.035f, 30.f, -H + 0.15f), metal_material(rng), "rail");
@@ -116,7 +114,7 @@ void dock_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float H = rng.uniform(0.9f, 1.4f);
   Material yard = concrete_material(rng);
   yard.albedo *= rng.uniform(0.35f, 0.8f);
-  two_levels(b.scene, rng, E, H, 20.f, 25.f, concrete_material(rng), yard);
+  two_levels(b.scene, E, H, 20.f, 25.f, concrete_material(rng), yard);
   Material rubber = fabric_material(rng);
   rubber.albedo = V3(0.08f, 0.08f, 0.08f);
   for (float y = rng.uniform(-4.f, -2.f); y < 4.f; y += rng.uniform(2.5f, 3.5f))
@@ -192,7 +190,7 @@ void platform_walk(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float H = rng.uniform(0.8f, 1.3f);
   Material bed = concrete_material(rng);
   bed.albedo *= rng.uniform(0.5f, 0.9f);
-  two_levels(b.scene, rng, E, H, 30.f, 5.f, concrete_material(rng), bed);
+  two_levels(b.scene, E, H, 30.f, 5.f, concrete_material(rng), bed);
   b.scene.add_box_in(E, V3(5.f, -30.f, -H - 0.3f), V3(10.f, 30.f, 0.f), concrete_material(rng), "platform");
   b.scene.add_box_in(E, V3(9.f, -30.f, 0.f), V3(9.3f, 30.f, 3.f), wall_material(rng), "wall");
   for (float x : {1.3f, 2.735f})
