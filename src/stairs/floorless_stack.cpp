@@ -283,7 +283,8 @@ int FloorlessStairs::split_at_landing() {
   if (!up_ok && !down_ok) return 0;
   const bool up = up_ok && (!down_ok || up_levels > down_levels);
   const std::size_t first = up ? static_cast<std::size_t>(u) : 0, last = up ? chain_.size() : static_cast<std::size_t>(u) + 1;
-  chain_.assign(chain_.begin() + static_cast<long>(first), chain_.begin() + static_cast<long>(last));
+  const std::vector<int> chain = chain_;  // copies: a vector is not assigned from its own range
+  chain_.assign(chain.begin() + static_cast<long>(first), chain.begin() + static_cast<long>(last));
   const std::vector<float> heights = trace_.level_heights;
   trace_.level_heights.assign(heights.begin() + static_cast<long>(first), heights.begin() + static_cast<long>(last));
   trace_.near_distances.assign(d.begin() + static_cast<long>(first), d.begin() + static_cast<long>(last));
