@@ -20,7 +20,7 @@ void FloorlessStairs::run_cold(const SceneResult& scene, const CameraIntrinsics*
   // refused it (the top of a descent: the treads below look nearer the user's feet; a floor strip
   // that might be a tread), and the stack does not reach it because the first steps are hidden
   // (self-occluded below a descending edge, under the view at the foot of a climb). A level a
-  // chest camera's height below the camera and a whole number of risers from the first seen level
+  // rig's height (0.4-1.9 m) below the camera and a whole number of risers from the first seen level
   // places the steps from the feet as a remembered height would. Without it, the checks below
   // settle whether the first seen level is the floor; otherwise its step number is unknown and the
   // stack is reported without_floor or refused.
@@ -78,7 +78,7 @@ void FloorlessStairs::decide_first_level(const SceneResult& scene, const CameraI
   const float depth = out.level_data[1].depth_max - out.level_data[1].depth_min;
   trace_.first_depth = depth;
   // Seen at a chest camera's pitch (the floor detector's range), the floor the user stands on lies
-  // a chest camera's height below it (the same detector's range): a level nearer the camera, or
+  // a rig's height below it (the floor detector's rig range, 0.4-1.9 m): a level nearer the camera, or
   // farther, is a step whatever its depth. A camera held level (a hand-held or tripod view) says
   // nothing of its height: there the rule does not apply.
   const float cam_above = -nodes_[static_cast<std::size_t>(chain_[0])].height;
@@ -96,7 +96,7 @@ void FloorlessStairs::decide_first_level(const SceneResult& scene, const CameraI
                             cam_above <= floor_.height_max + det_.same_level_tolerance;
   if (chest_view && !floor_height) return;
   // The other way round: were the level a first tread, the user's floor would lie one riser
-  // below it (ascending) or above it (descending); outside a chest camera's height range that
+  // below it (ascending) or above it (descending); outside the rig range that
   // cannot be the user's floor, so the level is.
   const float tread_cam = cam_above + static_cast<float>(dir) * out.riser_m;
   const bool tread_height = tread_cam >= floor_.height_min - det_.same_level_tolerance &&

@@ -229,7 +229,7 @@ FloorlessStairs::StackDirection FloorlessStairs::stack_direction() {
   // feet, so the stack takes it as its top level, while the floor under the user is out of view
   // below the first edge. Every lower pair says descending (a higher tread lies nearer), but that
   // level's nearest points are farther than the first tread's: no tread of the flight ahead is.
-  // A chest camera's height above it (FloorConfig range), it is the user's floor level: out of the
+  // A rig's height above it (FloorConfig's rig range), it is the user's floor level: out of the
   // stack, where the cold-start rule below (seen_floor_height) places the flight from it. Left in,
   // the direction is undecided, or modelled it would be one step too many. Two descending pairs
   // at least: one pair is no evidence (the floor strip at the foot of a short climb, seen only in a
