@@ -232,23 +232,6 @@ PresetDef def(const char* name, const char* summary, Fn fn, long frames = 1) {
 constexpr float kEdgeSpacing = 0.02f;
 constexpr float kMinSeen = 0.3f;
 
-// The point (camera frame) projects into the image, within range, and a pixel of its 3x3
-// neighbourhood has a rendered depth close to its own (nothing in front of it).
-bool point_seen(const V3& p, const cv::Mat& depth, const CameraIntrinsics& K, const SynthOptions& o) {
-  if (p.z() < o.min_range_m || p.z() > o.max_range_m) return false;
-  const int ui = static_cast<int>(std::lround(K.fx * p.x() / p.z() + K.cx));
-  const int vi = static_cast<int>(std::lround(K.fy * p.y() / p.z() + K.cy));
-  const float tol = 0.01f + 0.01f * p.z();
-  for (int dv = -1; dv <= 1; ++dv)
-    for (int du = -1; du <= 1; ++du) {
-      const int uu = ui + du, vv = vi + dv;
-      if (uu < 0 || vv < 0 || uu >= depth.cols || vv >= depth.rows) continue;
-      const float z = depth.at<float>(vv, uu);
-      if (z > 0.f && std::abs(z - p.z()) <= tol) return true;
-    }
-  return false;
-}
-
 }  // namespace
 
 const std::vector<PresetDef>& drop_defs() {

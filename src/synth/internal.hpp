@@ -58,6 +58,9 @@ const std::vector<PresetDef>& world2_defs();
 /// The drop-offs (issue 42 item 4), in synthetic_drops.cpp; and their ground truth (FrameTruth's
 /// drop_* fields) from the scene's drop edges and the ideal render.
 const std::vector<PresetDef>& drop_defs();
+/// True when the point (camera frame) is seen in the ideal render `depth`: it projects into the
+/// image and a pixel of its 3x3 neighbourhood has a rendered depth close to its own (truth.cpp).
+bool point_seen(const Eigen::Vector3f& p, const cv::Mat& depth, const CameraIntrinsics& K, const SynthOptions& o);
 void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal, const CameraIntrinsics& K,
                 const SynthOptions& o, FrameTruth& t);
 // nullptr when unknown.

@@ -13,6 +13,11 @@ constexpr int kMinTreadPixels = 200;
 constexpr float kEdgeSpacing = 0.02f;  // m between samples of the first edge
 constexpr float kMinRiserHeight = 0.08f;  // m, a wall or riser face at least this tall (wall_or_riser_pixels)
 
+
+}  // namespace
+
+namespace detail {
+
 // True when the point (camera frame) is seen: it projects into the image and a pixel of its 3x3
 // neighbourhood has a rendered depth close to the point's (no occluder in front of it).
 bool point_seen(const Eigen::Vector3f& p, const cv::Mat& depth, const CameraIntrinsics& K,
@@ -32,7 +37,7 @@ bool point_seen(const Eigen::Vector3f& p, const cv::Mat& depth, const CameraIntr
   return false;
 }
 
-}  // namespace
+}  // namespace detail
 
 FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal,
                          const CameraIntrinsics& K, const SynthOptions& o) {
@@ -124,7 +129,7 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
     bool end_a = false, end_b = false;
     for (int j = 0; j < n; ++j) {
       const float x = -half + step * static_cast<float>(j);
-      const bool s = point_seen(st.T_camera_stair * Eigen::Vector3f(x, 0.f, 0.f), ideal.depth, K, o);
+      const bool s = detail::point_seen(st.T_camera_stair * Eigen::Vector3f(x, 0.f, 0.f), ideal.depth, K, o);
       seen += s ? 1 : 0;
       if (j == 0) end_a = s;
       if (j == n - 1) end_b = s;
