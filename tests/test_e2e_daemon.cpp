@@ -23,7 +23,7 @@
 #include "file_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/config/config_loader.hpp"
 
 namespace fs = std::filesystem;

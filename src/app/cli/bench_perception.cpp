@@ -33,7 +33,7 @@
 #include "cli/command.hpp"
 #include "cli/open_input.hpp"
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace stairguide::cli {
