@@ -24,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include "file_test_util.hpp"
+
 namespace sgtest {
 
 /// Where the child's stdout goes.
@@ -220,11 +222,7 @@ class Daemon {
 
   /// What the child wrote to stderr so far ("" with stderr to /dev/null).
   std::string stderr_text() const {
-    if (err_path_.empty()) return "";
-    std::ifstream f(err_path_);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
+    return err_path_.empty() ? "" : stairguide::test::read_file(err_path_);
   }
 
  private:

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "capture_test_util.hpp"
+#include "file_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/capture/oni.hpp"
@@ -25,6 +26,7 @@
 namespace fs = std::filesystem;
 using namespace stairguide;
 using test::error_of;
+using test::read_file;
 
 namespace {
 
@@ -74,16 +76,9 @@ fs::path labels_dir(const std::string& name) {
   return d;
 }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
 /// Replaces the first `from` in the file with `to`; false when it is not there.
 bool edit(const fs::path& p, const std::string& from, const std::string& to) {
-  std::string s = read_all(p);
+  std::string s = read_file(p);
   const auto at = s.find(from);
   if (at == std::string::npos) return false;
   s.replace(at, from.size(), to);
@@ -103,7 +98,7 @@ TEST(HostilePcd, CompressedBodyWithAWrongUncompressedSizeIsRefusedBeforePclReads
   const RgbdFrame f = read_pcd_frame(good.string());
   EXPECT_EQ(f.depth.cols, 16);
   EXPECT_FLOAT_EQ(f.depth.at<float>(5, 5), 1.5f);
-  std::string bytes = read_all(good);
+  std::string bytes = read_file(good);
   const auto data = bytes.find("DATA binary_compressed\n");
   ASSERT_NE(data, std::string::npos);
   const std::size_t body = data + std::string("DATA binary_compressed\n").size();
@@ -191,7 +186,7 @@ TEST(HostileYaml, CameraYamlWithADuplicateKeyOrASecondDocumentIsRefused) {
 TEST(HostileYaml, LabelsWithADuplicateKeyASecondDocumentOrANanPoseAreRefused) {
   const fs::path d = labels_dir("labels");
   const fs::path labels = d / "labels.yaml";
-  const std::string original = read_all(labels);
+  const std::string original = read_file(labels);
   ASSERT_EQ(read_labels_yaml(labels.string()).size(), 1u);
 
   ASSERT_TRUE(edit(labels, "        steps: 3\n", "        steps: 3\n        steps: 30\n"));
@@ -300,7 +295,7 @@ TEST(HostileOni, RecordsOpenNI2sPlayerWouldTrustAreRefusedBeforeItSeesThem) {
   EXPECT_NE(e.find("crash-no-cropping.oni: corrupt recording (record at byte 1094: name not a string)"),
             std::string::npos)
       << e;
-  const std::string bytes = read_all(good);
+  const std::string bytes = read_file(good);
   // The colour stream's cropping property renamed: the player crashed once its frames came.
   const auto crop = bytes.rfind("xnCropping");
   ASSERT_NE(crop, std::string::npos);
@@ -372,7 +367,7 @@ TEST(HostileOni, CroppingAfterTheStreamIsReadyPlaysAsOpenNI2sPlayerDoes) {
     for (const auto& f : frames) w.write(f);
     w.close();
   }
-  std::string b = read_all(good);
+  std::string b = read_file(good);
   const auto recs = oni_records(b);
   // Moves record i to just after record j (i < j): the records between shift back, nothing else moves.
   auto move_after = [&](std::size_t i, std::size_t j) {

@@ -158,7 +158,7 @@ TEST(Oni, WriterRejectsWrongFrames) {
   EXPECT_NE(e.find("expected 32-bit float 80x60"), std::string::npos) << e;
 }
 
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 TEST(Oni, SyntheticSceneThroughOniKeepsDepth) {
   const fs::path p = scratch("synth.oni");

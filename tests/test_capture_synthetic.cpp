@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/synth/builders.hpp"
 
 using namespace stairguide;

@@ -15,22 +15,17 @@
 #include "cli_test_util.hpp"
 #include "stairguide/feedback/cue.hpp"
 #include "daemon_test_util.hpp"
+#include "file_test_util.hpp"
 #include "stairguide/config/config_loader.hpp"
 #include "vcam_test_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace stairguide;
+using test::read_file;
 
 namespace {
 
 const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "doctor_test_files";
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 /// A config for the doctor: the sounds of the source tree and the ALSA null device (this machine
 /// has no sound card; "null" takes the samples as a card would), the rest as given.

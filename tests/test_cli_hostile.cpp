@@ -10,7 +10,7 @@
 
 #include "cli_test_util.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 namespace fs = std::filesystem;
 using cli_test::CliRun;

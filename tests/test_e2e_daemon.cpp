@@ -20,37 +20,22 @@
 #include <vector>
 
 #include "daemon_test_util.hpp"
+#include "file_test_util.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/config/config_loader.hpp"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using namespace stairguide;
+using test::parse_kv;
+using test::read_file;
 
 namespace {
 
 const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_daemon_files";
 constexpr long kOniFrames = 150;  // 5 s at 30 Hz
-
-std::map<std::string, std::string> parse_kv(const std::string& line) {
-  std::istringstream is(line);
-  std::map<std::string, std::string> kv;
-  std::string tok;
-  while (is >> tok) {
-    const auto eq = tok.find('=');
-    if (eq != std::string::npos) kv[tok.substr(0, eq)] = tok.substr(eq + 1);
-  }
-  return kv;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 void write_file(const fs::path& p, const std::string& text) {
   std::ofstream f(p);

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "daemon_test_util.hpp"
+#include "file_test_util.hpp"
 
 using Clock = std::chrono::steady_clock;
 
@@ -53,10 +54,8 @@ TEST(DaemonStart, SigtermInTheFirstMillisecondsIsACleanStop) {
 }
 
 TEST(DaemonStart, UnitTimesOutAStuckStartAndDoesNotRestartOnABadConfig) {
-  std::ifstream f(std::string(STAIRGUIDE_SOURCE_DIR) + "/systemd/stairguide.service");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  const std::string unit = ss.str();
+  const std::string unit =
+      stairguide::test::read_file(std::string(STAIRGUIDE_SOURCE_DIR) + "/systemd/stairguide.service");
   EXPECT_EQ(unit.find("TimeoutStartSec=infinity"), std::string::npos);
   EXPECT_NE(unit.find("\nTimeoutStartSec=30s\n"), std::string::npos);
   EXPECT_NE(unit.find("\nRestart=on-failure\n"), std::string::npos);

@@ -16,18 +16,13 @@
 #include "stairguide/config/config_loader.hpp"
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/feedback/sound_bank.hpp"
+#include "file_test_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace stairguide;
+using stairguide::test::read_file;
 
 namespace {
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 /// A scratch DESTDIR under the build folder, removed at the end of the test.
 struct Destdir {

@@ -21,17 +21,12 @@
 #include <string>
 
 #include "cli_test_util.hpp"
+#include "file_test_util.hpp"
 
 namespace fs = std::filesystem;
+using stairguide::test::read_file;
 
 namespace {
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 cli_test::CliRun sh(const std::string& command) { return cli_test::run_shell(command); }
 

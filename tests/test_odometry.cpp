@@ -13,7 +13,7 @@
 #include <optional>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/odometry/trajectory_metrics.hpp"
 #include "test_odometry_scene.hpp"

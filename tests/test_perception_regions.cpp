@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/synth/builders.hpp"
 #include "stairguide/synth/render.hpp"
 #include "stairguide/perception/perception.hpp"

@@ -22,6 +22,7 @@
 #include <new>
 #include <system_error>
 
+#include "file_test_util.hpp"
 #include "stairguide/runtime/frame_clock.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/logging.hpp"
@@ -146,16 +147,7 @@ struct Lines {
     std::rewind(f);
     std::vector<std::map<std::string, std::string>> out;
     char buf[1024];
-    while (std::fgets(buf, sizeof buf, f)) {
-      std::istringstream is(buf);
-      std::map<std::string, std::string> kv;
-      std::string tok;
-      while (is >> tok) {
-        const auto eq = tok.find('=');
-        if (eq != std::string::npos) kv[tok.substr(0, eq)] = tok.substr(eq + 1);
-      }
-      out.push_back(kv);
-    }
+    while (std::fgets(buf, sizeof buf, f)) out.push_back(stairguide::test::parse_kv(buf));
     return out;
   }
 };

@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 

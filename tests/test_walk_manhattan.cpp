@@ -16,7 +16,7 @@
 
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/core/config.hpp"
 #include "stairguide/odometry/dense_odometry.hpp"
 #include "stairguide/perception/perception.hpp"

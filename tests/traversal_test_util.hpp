@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/core/config.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stairs.hpp"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "stairguide/capture/dataset.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 namespace stairguide::test {
 

@@ -8,7 +8,7 @@
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/device.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 namespace fs = std::filesystem;
 

@@ -370,21 +370,31 @@ std::function<float(double)> approach_and_cross(float stop, float cross_to, floa
   };
 }
 
-void sequence_camera(Rng& rng, const SynthOptions& o, WalkSpec& w) {
+WalkSpec& start_walk(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  b.sequence = true;
+  WalkSpec& w = b.walk;
   w.camera_height_m = pick(o.camera_height_m, rng.uniform(1.2f, 1.45f));
   w.tilt_rad = deg2rad(pick(o.camera_tilt_deg, rng.uniform(40.f, 50.f)));
   w.roll_rad = deg2rad(pick(o.camera_roll_deg, rng.uniform(-2.f, 2.f)));
+  return w;
 }
 
-void ascending_approach_climb(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+// The demonstration walks' flight: 8 steps, risers 16-17.5 cm, treads 28-31 cm, 1.1-1.4 m wide,
+// side walls and handrails.
+StairParams walk_flight(Rng& rng, StairKind kind) {
   StairParams p;
-  p.kind = StairKind::kAscending;
+  p.kind = kind;
   p.steps = 8;
   p.riser_m = rng.uniform(0.16f, 0.175f);
   p.tread_m = rng.uniform(0.28f, 0.31f);
   p.width_m = rng.uniform(1.1f, 1.4f);
   p.side_walls = true;
   p.handrails = true;
+  return p;
+}
+
+void ascending_approach_climb(Rng& rng, const SynthOptions& o, PresetBuild& b) {
+  StairParams p = walk_flight(rng, StairKind::kAscending);
   p.wall_start_m = -0.8f;
   p.top_depth_m = 3.f;
   const float edge_x = 3.3f;
@@ -394,9 +404,7 @@ void ascending_approach_climb(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   add_door_somewhere(b.scene, rng, 2.2f, -1.5f, 1.5f, true);
   add_crate(b.scene, V3(1.5f, -1.7f, 0.f), 0.2f, V3(0.5f, 0.4f, 0.45f), wood_material(rng), "clutter");
   add_staircase(b.scene, p, rng);
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
+  WalkSpec& w = start_walk(rng, o, b);
   w.duration_s = 20.f;
   const StairSpec& st = b.scene.stairs[0];
   stair_walk(w, st, edge_x);
@@ -406,14 +414,7 @@ void ascending_approach_climb(Rng& rng, const SynthOptions& o, PresetBuild& b) {
 }
 
 void descending_approach_descend(Rng& rng, const SynthOptions& o, PresetBuild& b) {
-  StairParams p;
-  p.kind = StairKind::kDescending;
-  p.steps = 8;
-  p.riser_m = rng.uniform(0.16f, 0.175f);
-  p.tread_m = rng.uniform(0.28f, 0.31f);
-  p.width_m = rng.uniform(1.1f, 1.4f);
-  p.side_walls = true;
-  p.handrails = true;
+  StairParams p = walk_flight(rng, StairKind::kDescending);
   const float edge_x = 3.3f;
   p.T_world_stair = stair_pose(edge_x, 0.f, 0.f, 0.f);
   const float total = 8.f * p.riser_m;
@@ -421,9 +422,7 @@ void descending_approach_descend(Rng& rng, const SynthOptions& o, PresetBuild& b
   add_room_walls(b.scene, V2(-2.f, -2.5f), V2(edge_x + 7.f * p.tread_m + 6.f, 2.5f), -total - 0.2f,
                  2.9f + total, wall_material(rng));
   add_crate(b.scene, V3(1.2f, 1.9f, 0.f), 0.1f, V3(0.5f, 0.4f, 0.45f), wood_material(rng), "clutter");
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
+  WalkSpec& w = start_walk(rng, o, b);
   w.duration_s = 20.f;
   stair_walk(w, b.scene.stairs[0], edge_x);
   const float stop = edge_x - 0.25f, bottom = edge_x + 7.f * p.tread_m + 0.35f;
@@ -444,9 +443,7 @@ void ascending_turn_fast(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   add_table(b.scene, V3(1.0f, 2.2f, 0.f), 0.f, 0.75f, 1.2f, 0.7f, rng);
   add_crate(b.scene, V3(2.5f, -2.4f, 0.f), 0.3f, V3(0.6f, 0.5f, 0.5f), wood_material(rng), "clutter");
   add_staircase(b.scene, p, rng);
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
+  WalkSpec& w = start_walk(rng, o, b);
   w.duration_s = 10.f;
   stair_walk(w, b.scene.stairs[0], edge_x);
   const float stop = edge_x - 0.4f;
@@ -476,9 +473,7 @@ void descending_people_approach(Rng& rng, const SynthOptions& o, PresetBuild& b)
   const V3 feet(edge_x + (static_cast<float>(k) - 0.5f) * st.tread_m, rng.uniform(-0.2f, 0.2f) * st.width_m,
                 st.tread_height(k));
   add_person(b.scene, feet, 3.14159265f + rng.uniform(-0.3f, 0.3f), rng.uniform(1.6f, 1.85f), rng);
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
+  WalkSpec& w = start_walk(rng, o, b);
   w.duration_s = 10.f;
   stair_walk(w, st, edge_x);
   const float stop = edge_x - 0.3f;

@@ -25,8 +25,9 @@ Pose stair_ahead(Rng& rng, float yaw, float edge_z, float* dist = nullptr);
 void descending_in_room(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p);
 // A room 9 x 7 m around the user at the origin.
 void room(Rng& rng, PresetBuild& b);
-// A walk's camera: 1.2-1.45 m high, tilted 40-50 deg, rolled +-2 deg (unless the options fix them).
-void sequence_camera(Rng& rng, const SynthOptions& o, WalkSpec& w);
+// Makes `b` a sequence and gives its walk a camera 1.2-1.45 m high, tilted 40-50 deg, rolled
+// +-2 deg (unless the options fix them); returns the walk.
+WalkSpec& start_walk(Rng& rng, const SynthOptions& o, PresetBuild& b);
 // Walk geometry along +x through a staircase whose first edge is at x = edge_x.
 void stair_walk(WalkSpec& w, const StairSpec& st, float edge_x);
 

@@ -63,18 +63,11 @@ inline float texture_at(const FaceShade& s, float ts, float tt) {
   return top + (bot - top) * ay;
 }
 
-}  // namespace
-
-void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsics& K, RenderBuffers& out,
-            bool shade) {
+// Phase 1: every face in view, clipped at the near plane, rasterised into out.depth (inverse depth,
+// nearest wins) and out.face. Returns the faces drawn.
+std::vector<int> rasterize(const Scene& scene, const Pose& T_cw, const CameraIntrinsics& K,
+                           RenderBuffers& out) {
   const int W = K.width, H = K.height;
-  out.depth.create(H, W, CV_32FC1);
-  out.face.create(H, W, CV_32SC1);
-  out.cos_incidence.create(H, W, CV_32FC1);
-  out.depth.setTo(0.f);  // holds inverse depth until the end; 0 = infinitely far
-  out.face.setTo(-1);
-
-  const Pose T_cw = T_world_camera.inverse();
   const Eigen::Matrix3f R_cw = T_cw.linear();
   const float fx = K.fx, fy = K.fy, cx = K.cx, cy = K.cy;
 
@@ -175,9 +168,16 @@ void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsi
       }
     }
   }
+  return drawn;
+}
 
-  // Per-face terms for the per-pixel pass (light is directional, so Lambert is constant per
-  // face; colour = albedo * Lambert * (1 + contrast * texture)).
+// Phase 2: the per-face terms of the per-pixel pass (light is directional, so Lambert is constant
+// per face; colour = albedo * Lambert * (1 + contrast * texture)).
+std::vector<FaceShade> face_terms(const Scene& scene, const Pose& T_world_camera,
+                                  const Eigen::Matrix3f& R_cw, const CameraIntrinsics& K,
+                                  const std::vector<int>& drawn) {
+  const float fx = K.fx, fy = K.fy, cx = K.cx, cy = K.cy;
+  const auto& faces = scene.faces();
   const Eigen::Vector3f light = scene.light_dir.normalized();
   const Eigen::Vector3f t_wc = T_world_camera.translation();
   const auto& solids = scene.solids();
@@ -208,7 +208,15 @@ void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsi
     const float lambert = scene.ambient + (1.f - scene.ambient) * std::max(0.f, f.normal.dot(light));
     for (int c = 0; c < 3; ++c) s.col[c] = 255.f * lambert * mat.albedo[c];
   }
+  return fs;
+}
 
+// Phase 3: per pixel, depth from inverse depth (with a relief's texture), the cosine of incidence
+// and, with `shade`, the colour.
+void shade_pixels(const std::vector<FaceShade>& fs, const CameraIntrinsics& K, bool shade,
+                  RenderBuffers& out) {
+  const int W = K.width, H = K.height;
+  const float fx = K.fx, fy = K.fy, cx = K.cx, cy = K.cy;
   if (shade) out.color.create(H, W, CV_8UC3);
   constexpr int TN = detail::kTextureSize;
   std::vector<float> ray_norm_inv(static_cast<std::size_t>(W));
@@ -263,6 +271,22 @@ void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsi
       }
     }
   }
+}
+
+}  // namespace
+
+void render(const Scene& scene, const Pose& T_world_camera, const CameraIntrinsics& K, RenderBuffers& out,
+            bool shade) {
+  const int W = K.width, H = K.height;
+  out.depth.create(H, W, CV_32FC1);
+  out.face.create(H, W, CV_32SC1);
+  out.cos_incidence.create(H, W, CV_32FC1);
+  out.depth.setTo(0.f);  // holds inverse depth until the end; 0 = infinitely far
+  out.face.setTo(-1);
+
+  const Pose T_cw = T_world_camera.inverse();
+  const std::vector<int> drawn = rasterize(scene, T_cw, K, out);
+  shade_pixels(face_terms(scene, T_world_camera, T_cw.linear(), K, drawn), K, shade, out);
 }
 
 }  // namespace stairguide::synth

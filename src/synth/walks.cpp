@@ -58,9 +58,7 @@ void flight_walk(Rng& rng, const SynthOptions& o, PresetBuild& b, const FlightWa
     add_person(b.scene, feet, 3.14159265f + rng.uniform(-0.3f, 0.3f), rng.uniform(1.6f, 1.85f), rng);
     walker_y = -side * 0.22f;
   }
-  b.sequence = true;
-  WalkSpec& w = b.walk;
-  sequence_camera(rng, o, w);
+  WalkSpec& w = start_walk(rng, o, b);
   w.start = V3(0.f, walker_y, 0.f);
   stair_walk(w, st, edge_x);
   const float rate = rng.uniform(fw.rate_lo, fw.rate_hi);

@@ -195,7 +195,7 @@ struct PresetDef;
 }  // namespace detail
 
 /// Renders the frames of one preset in turn, keeping a sequence's scene and walk between frames:
-/// what the synthetic FrameSource (capture/synthetic_source.hpp, `synth:` inputs) reads.
+/// what the synthetic FrameSource (capture/synth_source.hpp, `synth:` inputs) reads.
 class PresetRenderer {
  public:
   /// `frames` <= 0 takes the preset's default_frames; a sequence asked for more frames than its

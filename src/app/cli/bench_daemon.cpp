@@ -88,6 +88,20 @@ Run run_once(const PipelineConfig& config, std::shared_ptr<const std::vector<Rgb
   return r;
 }
 
+// The frames of `src` read into memory (at most `limit`; all when it is negative); a read error
+// throws.
+std::shared_ptr<std::vector<RgbdFrame>> read_frames(FrameSource& src, long limit) {
+  auto frames = std::make_shared<std::vector<RgbdFrame>>();
+  for (long i = 0; limit < 0 || i < limit; ++i) {
+    RgbdFrame f;
+    const ReadResult r = src.read(f);
+    if (r.status == ReadStatus::kEnd) break;
+    if (!r.ok()) throw std::runtime_error(r.message);
+    frames->push_back(std::move(f));
+  }
+  return frames;
+}
+
 std::string run_json(const Run& r) {
   const auto& s = r.stats;
   char buf[1024];
@@ -178,15 +192,8 @@ int bench_cues(const PipelineConfig& config, const std::vector<std::string>& wal
     auto src = open_frame_source("synth:" + walk, config.capture);
     const CameraIntrinsics k = src->intrinsics();
     const std::string desc = src->describe();
-    auto frames = std::make_shared<std::vector<RgbdFrame>>();
     if (!json) std::fprintf(stderr, "bench daemon --cues: %s: rendering...\n", walk.c_str());
-    for (;;) {
-      RgbdFrame f;
-      const ReadResult r = src->read(f);
-      if (r.status == ReadStatus::kEnd) break;
-      if (!r.ok()) throw std::runtime_error(r.message);
-      frames->push_back(std::move(f));
-    }
+    auto frames = read_frames(*src, -1);
     src.reset();
     const long n = static_cast<long>(frames->size());
     if (!json) std::fprintf(stderr, "bench daemon --cues: %s: %ld frames at 30 Hz (%.0f s)...\n", walk.c_str(), n, n / 30.0);
@@ -294,15 +301,8 @@ int bench_daemon(Context& ctx) {
   auto src = open_frame_source(input, config.capture);
   const std::string desc = src->describe();
   const CameraIntrinsics k = src->intrinsics();
-  auto frames = std::make_shared<std::vector<RgbdFrame>>();
   if (!json) std::fprintf(stderr, "bench daemon: reading %s into memory...\n", desc.c_str());
-  for (long i = 0; i < frames_wanted; ++i) {
-    RgbdFrame f;
-    const ReadResult r = src->read(f);
-    if (r.status == ReadStatus::kEnd) break;
-    if (!r.ok()) throw std::runtime_error(r.message);
-    frames->push_back(std::move(f));
-  }
+  auto frames = read_frames(*src, frames_wanted);
   src.reset();
   if (frames->empty()) throw UsageError(input + ": no frames");
   const long n = static_cast<long>(frames->size());

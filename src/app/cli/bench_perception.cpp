@@ -31,8 +31,9 @@
 
 #include "cli/bench_util.hpp"
 #include "cli/command.hpp"
+#include "cli/open_input.hpp"
 #include "stairguide/capture/frame_source.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/perception/perception.hpp"
 
 namespace stairguide::cli {
@@ -215,13 +216,9 @@ int bench_perception(Context& ctx) {
   if (dir) {
     const long limit = count > 0 ? count : 30;
     for (const std::string& input : frame_inputs(*dir)) {
-      std::unique_ptr<FrameSource> src;
-      try {
-        src = open_frame_source(input, ctx.config.capture);
-      } catch (const SourceError& e) {
-        std::fprintf(stderr, "stairguide bench perception: %s\n", e.what());
-        return 1;
-      }
+      const std::unique_ptr<FrameSource> src =
+          open_input(input, ctx.config.capture, "stairguide bench perception");
+      if (!src) return 1;
       RgbdFrame f;
       while (static_cast<long>(frames.size()) < limit) {
         const ReadResult r = src->read(f);

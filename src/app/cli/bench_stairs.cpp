@@ -10,7 +10,7 @@
 
 #include "cli/bench_util.hpp"
 #include "cli/command.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 #include "stairguide/perception/perception.hpp"
 #include "stairguide/stairs/stairs.hpp"
 

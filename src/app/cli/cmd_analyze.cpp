@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "cli/open_input.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
 
@@ -58,13 +59,8 @@ int analyze(Context& ctx) {
   const auto pos = ctx.positionals(1, 1);
   const std::string& input = pos[0];
 
-  std::unique_ptr<FrameSource> source;
-  try {
-    source = open_frame_source(input, ctx.config.capture);
-  } catch (const SourceError& e) {
-    std::fprintf(stderr, "stairguide analyze: %s\n", e.what());
-    return 1;
-  }
+  const std::unique_ptr<FrameSource> source = open_input(input, ctx.config.capture, "stairguide analyze");
+  if (!source) return 1;
   if (source->frame_count() >= 0 && index >= source->frame_count()) {
     std::fprintf(stderr, "stairguide analyze: --frame %ld is out of range: %s has %ld frame(s)\n", index,
                  source->describe().c_str(), source->frame_count());

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "cli/open_input.hpp"
 #include "stairguide/core/json.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
@@ -40,13 +41,8 @@ int detect(Context& ctx) {
   const auto pos = ctx.positionals(1, 1);
   const std::string input = pos[0];
 
-  std::unique_ptr<FrameSource> source;
-  try {
-    source = open_frame_source(input, ctx.config.capture);
-  } catch (const SourceError& e) {
-    std::fprintf(stderr, "stairguide detect: %s\n", e.what());
-    return 1;
-  }
+  const std::unique_ptr<FrameSource> source = open_input(input, ctx.config.capture, "stairguide detect");
+  if (!source) return 1;
   if (source->frame_count() >= 0 && frame_no >= source->frame_count()) {
     std::fprintf(stderr, "stairguide detect: --frame %ld is past the end of %s (%ld frames)\n", frame_no,
                  source->describe().c_str(), source->frame_count());

@@ -9,7 +9,7 @@
 #include "cli/command.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/oni.hpp"
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 namespace stairguide::cli {
 namespace {

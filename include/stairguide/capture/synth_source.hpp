@@ -1,5 +1,5 @@
 #pragma once
-/// \file synthetic_source.hpp
+/// \file synth_source.hpp
 /// The synthetic world (synth/synth.hpp) as a FrameSource: what a `synth:` input opens.
 
 #include <cstdint>

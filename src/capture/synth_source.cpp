@@ -1,5 +1,5 @@
 // The synthetic FrameSource: a thin reader over synth::PresetRenderer.
-#include "stairguide/capture/synthetic_source.hpp"
+#include "stairguide/capture/synth_source.hpp"
 
 namespace stairguide::synth {
 namespace {
