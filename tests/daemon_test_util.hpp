@@ -221,9 +221,7 @@ class Daemon {
   }
 
   /// What the child wrote to stderr so far ("" with stderr to /dev/null).
-  std::string stderr_text() const {
-    return err_path_.empty() ? "" : stairguide::test::read_file(err_path_);
-  }
+  std::string stderr_text() const { return err_path_.empty() ? "" : stairguide::test::read_file(err_path_); }
 
  private:
   static std::chrono::steady_clock::time_point deadline(double s) {

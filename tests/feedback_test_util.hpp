@@ -24,7 +24,8 @@ inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/
 /// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 raw, interleaved
 /// as many channels as the sink opened it with). The names in `mono_only` are PCMs that refuse
 /// two channels (a `multi` PCM of one binding over the file PCM), as a mono sound card does.
-inline void write_alsa_config(const fs::path& conf, const fs::path& dir, const std::vector<std::string>& names,
+inline void write_alsa_config(const fs::path& conf, const fs::path& dir,
+                              const std::vector<std::string>& names,
                               const std::vector<std::string>& mono_only = {}) {
   fs::create_directories(dir);
   std::ofstream f(conf);
@@ -32,8 +33,9 @@ inline void write_alsa_config(const fs::path& conf, const fs::path& dir, const s
     f << "pcm." << n << " {\n  type file\n  slave.pcm { type null }\n  file \""
       << (dir / (n + ".raw")).string() << "\"\n  format \"raw\"\n}\n";
   for (const auto& n : mono_only)
-    f << "pcm." << n << "_file {\n  type file\n  slave.pcm { type null }\n  file \"" << (dir / (n + ".raw")).string()
-      << "\"\n  format \"raw\"\n}\npcm." << n << " {\n  type multi\n  slaves.a { pcm \"" << n
+    f << "pcm." << n << "_file {\n  type file\n  slave.pcm { type null }\n  file \""
+      << (dir / (n + ".raw")).string() << "\"\n  format \"raw\"\n}\npcm." << n
+      << " {\n  type multi\n  slaves.a { pcm \"" << n
       << "_file\" channels 1 }\n  bindings.0 { slave a channel 0 }\n}\n";
 }
 
@@ -66,7 +68,8 @@ inline Stereo split(const std::vector<std::int16_t>& interleaved) {
   return s;
 }
 /// Energy of samples [from, to) (whole capture by default).
-inline double energy(const std::vector<std::int16_t>& s, std::size_t from = 0, std::size_t to = ~std::size_t{0}) {
+inline double energy(const std::vector<std::int16_t>& s, std::size_t from = 0,
+                     std::size_t to = ~std::size_t{0}) {
   double e = 0.0;
   for (std::size_t i = from; i < std::min(to, s.size()); ++i) e += static_cast<double>(s[i]) * s[i];
   return e;

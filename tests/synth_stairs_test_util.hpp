@@ -29,7 +29,8 @@ struct SynthStairs {
     return result;
   }
   /// Both.
-  const stairguide::StairResult& step(const std::string& preset, long i, std::uint32_t seed, bool cold = false) {
+  const stairguide::StairResult& step(const std::string& preset, long i, std::uint32_t seed,
+                                      bool cold = false) {
     perceive(preset, i, seed, cold);
     return stairs();
   }
@@ -59,7 +60,8 @@ struct WorldFigures {
       ++full_frames;
       full_detected += e.outcome == EvalOutcome::kTP;
     }
-    return e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kTN && e.outcome != EvalOutcome::kSkipped;
+    return e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kTN &&
+           e.outcome != EvalOutcome::kSkipped;
   }
 };
 

@@ -491,7 +491,8 @@ TEST(Dataset, ListsWhoseClockJumpsBackOrStandsStillArePairedInFileOrder) {
       DatasetWriter w(d.string(), frames[0].intrinsics);
       for (std::size_t i = 0; i < frames.size(); ++i) {
         RgbdFrame f = frames[i];
-        f.timestamp = std::string(kind) == "equal" ? 3.0 : 1.0 + 0.1 * static_cast<double>(i) - (i >= 4 ? 0.4 : 0.0);
+        f.timestamp =
+            std::string(kind) == "equal" ? 3.0 : 1.0 + 0.1 * static_cast<double>(i) - (i >= 4 ? 0.4 : 0.0);
         w.write(f);
       }
       w.close();
@@ -501,8 +502,8 @@ TEST(Dataset, ListsWhoseClockJumpsBackOrStandsStillArePairedInFileOrder) {
     for (std::size_t i = 0; i < frames.size(); ++i) {
       ASSERT_TRUE(s.read(f).ok()) << kind << " " << i;
       ASSERT_FALSE(f.color.empty()) << kind << " " << i;
-      EXPECT_EQ(cv::norm(f.color, frames[i].color, cv::NORM_INF), 0.0) << kind << ": frame " << i
-                                                                        << " got another frame's colour";
+      EXPECT_EQ(cv::norm(f.color, frames[i].color, cv::NORM_INF), 0.0)
+          << kind << ": frame " << i << " got another frame's colour";
     }
   }
 }

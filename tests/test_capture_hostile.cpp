@@ -343,7 +343,8 @@ std::uint32_t get32(const std::string& b, std::size_t at) {
 std::vector<OniRecord> oni_records(const std::string& b) {
   std::vector<OniRecord> out;
   for (std::size_t pos = 24; pos + 28 <= b.size();) {
-    OniRecord r{pos, get32(b, pos + 12) + std::size_t{get32(b, pos + 16)}, get32(b, pos + 4), get32(b, pos + 8), ""};
+    OniRecord r{pos, get32(b, pos + 12) + std::size_t{get32(b, pos + 16)}, get32(b, pos + 4),
+                get32(b, pos + 8), ""};
     if (r.type >= 0x03 && r.type <= 0x06) r.name = b.substr(pos + 32, get32(b, pos + 28) - 1);
     out.push_back(r);
     if (r.type == 0x0B) break;
@@ -423,7 +424,8 @@ TEST(HostileFiles, PermissionDeniedAndSymlinkLoopsAreNamedByTheirCause) {
   dataset(shut / "inner");
   fs::path depth_png;
   for (const auto& e : fs::recursive_directory_iterator(open_img))
-    if (e.path().extension() == ".png" && e.path().string().find("depth") != std::string::npos) depth_png = e.path();
+    if (e.path().extension() == ".png" && e.path().string().find("depth") != std::string::npos)
+      depth_png = e.path();
   ASSERT_FALSE(depth_png.empty());
   const fs::path oni = root / "rec.oni";
   {
@@ -488,14 +490,16 @@ TEST(HostileFiles, PermissionDeniedAndSymlinkLoopsAreNamedByTheirCause) {
   EXPECT_NE(m[0].find("dataset " + closed.string() + ": cannot read the folder (permission denied)"),
             std::string::npos)
       << m[0];
-  EXPECT_NE(m[1].find(depth_png.string() + ": cannot read depth image (permission denied)"), std::string::npos)
+  EXPECT_NE(m[1].find(depth_png.string() + ": cannot read depth image (permission denied)"),
+            std::string::npos)
       << m[1];
   EXPECT_NE(m[2].find("oni " + oni.string() + ": cannot read the recording (permission denied)"),
             std::string::npos)
       << m[2];
   EXPECT_NE(m[3].find("cannot open it (permission denied)"), std::string::npos) << m[3];
   for (const auto& l : m)
-    for (const char* wrong : {"no such", "missing", "corrupt"}) EXPECT_EQ(l.find(wrong), std::string::npos) << l;
+    for (const char* wrong : {"no such", "missing", "corrupt"})
+      EXPECT_EQ(l.find(wrong), std::string::npos) << l;
 
   // A symlink loop as the input.
   fs::create_symlink("loop", root / "loop");

@@ -204,9 +204,10 @@ TEST(SyntheticSensor, CorrelatedNoiseKeepsTheKinectSigma) {
       lag1[k] = (sxy / m) / (s2 / n);
     }
     const double model = 1.425e-3 * dist * dist;
-    std::printf("[ noise ] z = %.2f m: sigma white %.2f mm, correlated %.2f mm, model %.2f mm; neighbours' "
-                "correlation white %.2f, correlated %.2f\n", dist, sigma[0] * 1e3, sigma[1] * 1e3, model * 1e3,
-                lag1[0], lag1[1]);
+    std::printf(
+        "[ noise ] z = %.2f m: sigma white %.2f mm, correlated %.2f mm, model %.2f mm; neighbours' "
+        "correlation white %.2f, correlated %.2f\n",
+        dist, sigma[0] * 1e3, sigma[1] * 1e3, model * 1e3, lag1[0], lag1[1]);
     EXPECT_NEAR(sigma[1] / model, 1.0, 0.2) << "at " << dist << " m";
     EXPECT_LT(lag1[0], 0.1) << "white noise at " << dist << " m";
     EXPECT_GT(lag1[1], 0.5) << "correlated noise at " << dist << " m";

@@ -35,8 +35,9 @@ TEST(CliAnalyze, SyntheticFrameAsTextAndJson) {
   const CliRun j = run("analyze synth:ascending_static:1:5 --json");
   ASSERT_EQ(j.code, 0) << j.out;
   EXPECT_EQ(j.out.front(), '{') << j.out;
-  for (const char* key : {"\"floor_found\": true", "\"camera_height_m\"", "\"manhattan_yaw_deg\"", "\"regions\": [{",
-                          "\"class\": \"floor\"", "\"class\": \"step_candidate\"", "\"height_m\"", "\"timings_ms\""})
+  for (const char* key :
+       {"\"floor_found\": true", "\"camera_height_m\"", "\"manhattan_yaw_deg\"", "\"regions\": [{",
+        "\"class\": \"floor\"", "\"class\": \"step_candidate\"", "\"height_m\"", "\"timings_ms\""})
     EXPECT_TRUE(has(j.out, key)) << key << " missing in " << j.out.substr(0, 400);
 }
 
@@ -49,7 +50,8 @@ TEST(CliAnalyze, ManhattanWithoutAFloorIsSaid) {
   EXPECT_TRUE(has(t.out, "no floor: about the vertical of a floor-like plane refused as the floor")) << t.out;
   const CliRun j = run("analyze synth:ascending_short_static:24:20261123 --frame 13 --json");
   ASSERT_EQ(j.code, 0) << j.out;
-  for (const char* key : {"\"floor_found\": false", "\"manhattan_found\": true", "\"manhattan_without_floor\": true"})
+  for (const char* key :
+       {"\"floor_found\": false", "\"manhattan_found\": true", "\"manhattan_without_floor\": true"})
     EXPECT_TRUE(has(j.out, key)) << key << " missing in " << j.out.substr(0, 400);
 }
 
@@ -89,7 +91,8 @@ TEST(CliAnalyze, OniRecordingFrame) {
   fs::remove(oni);
   // Consecutive frames of a walk: the frames before the one asked for go through perception
   // too, as in a live run (a recording of unrelated static views would jump the tracked floor).
-  const CliRun s = run("synth --scene ascending_approach_climb --frames 3 --seed 5 --out " + dir + " --oni " + oni);
+  const CliRun s =
+      run("synth --scene ascending_approach_climb --frames 3 --seed 5 --out " + dir + " --oni " + oni);
   ASSERT_EQ(s.code, 0) << s.out;
   const CliRun r = run("analyze " + oni + " --frame 2 --json");
   ASSERT_EQ(r.code, 0) << r.out;
@@ -106,7 +109,8 @@ TEST(CliAnalyze, OniRecordingFrame) {
 }
 
 TEST(CliAnalyze, RealDepthPngDatasetFrameAndOrganizedPcd) {
-  if (!fs::exists(kKitchen + "/camera.yaml")) GTEST_SKIP() << "no 7-Scenes kitchen under " << STAIRGUIDE_SHARED_DATA;
+  if (!fs::exists(kKitchen + "/camera.yaml"))
+    GTEST_SKIP() << "no 7-Scenes kitchen under " << STAIRGUIDE_SHARED_DATA;
   // A depth PNG finds camera.yaml in its parent folder.
   const CliRun png = run("analyze " + kKitchen + "/depth/0.000000.png");
   ASSERT_EQ(png.code, 0) << png.out;
@@ -119,7 +123,8 @@ TEST(CliAnalyze, RealDepthPngDatasetFrameAndOrganizedPcd) {
   EXPECT_TRUE(has(set.out, "\"class\": \"floor\"")) << set.out.substr(0, 400);
   // An organized PCD from PCL's data: a level camera, so no chest-camera floor; the planes are
   // still segmented and the reason is given.
-  const std::string pcd = std::string(STAIRGUIDE_SHARED_DATA) + "/pcl-kinect-clouds/tutorials_pairwise/capture0001.pcd";
+  const std::string pcd =
+      std::string(STAIRGUIDE_SHARED_DATA) + "/pcl-kinect-clouds/tutorials_pairwise/capture0001.pcd";
   if (fs::exists(pcd)) {
     const CliRun c = run("analyze " + pcd + " --json");
     ASSERT_EQ(c.code, 0) << c.out;

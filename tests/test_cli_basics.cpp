@@ -36,7 +36,8 @@ TEST(Cli, EveryCommandTakesConfigAndABadOneStopsIt) {
   const CliRun r = run("--config " + path + " synth --list");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("odometry.iterations"), std::string::npos) << r.out;
-  const CliRun ok = run(std::string("synth --list --config ") + STAIRGUIDE_SOURCE_DIR + "/config/stairguide.yaml");
+  const CliRun ok =
+      run(std::string("synth --list --config ") + STAIRGUIDE_SOURCE_DIR + "/config/stairguide.yaml");
   EXPECT_EQ(ok.code, 0) << ok.out;
 }
 

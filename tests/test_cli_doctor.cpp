@@ -47,8 +47,8 @@ PipelineConfig null_sound_config() {
 /// `stairguide --config CONFIG doctor ARGS` with `env` before it; the user checked is root, who
 /// exists everywhere (the service user exists only where the package is installed).
 cli_test::CliRun doctor(const fs::path& config, const std::string& args, const std::string& env = "") {
-  return cli_test::run_shell(env + " " + STAIRGUIDE_CLI + " --config '" + config.string() + "' doctor --user root " +
-                             args);
+  return cli_test::run_shell(env + " " + STAIRGUIDE_CLI + " --config '" + config.string() +
+                             "' doctor --user root " + args);
 }
 
 struct JsonCheck {
@@ -81,7 +81,8 @@ const JsonCheck* find(const std::vector<JsonCheck>& checks, const std::string& n
 // This machine as it is: no camera, no GPIO chip. Exit 1, the camera and the buzzer line named
 // (each with a fix), every other check passing or informational, in the order a helper works.
 TEST(Doctor, WithoutCameraAndGpioItFailsNamingTheCameraAndTheBuzzerOnly) {
-  if (fs::exists("/dev/gpiochip0")) GTEST_SKIP() << "this machine has a GPIO chip: the buzzer check could pass";
+  if (fs::exists("/dev/gpiochip0"))
+    GTEST_SKIP() << "this machine has a GPIO chip: the buzzer check could pass";
   const fs::path config = write_config("nohw", null_sound_config());
   const cli_test::CliRun j = doctor(config, "--json");
   EXPECT_EQ(j.code, 1) << j.out;
@@ -103,9 +104,14 @@ TEST(Doctor, WithoutCameraAndGpioItFailsNamingTheCameraAndTheBuzzerOnly) {
   }
   ASSERT_NE(find(checks, "camera"), nullptr);
   EXPECT_NE(find(checks, "camera")->message.find("no camera found"), std::string::npos) << j.out;
-  EXPECT_NE(find(checks, "buzzer")->message.find("GPIO chip 'gpiochip0' line 17"), std::string::npos) << j.out;
+  EXPECT_NE(find(checks, "buzzer")->message.find("GPIO chip 'gpiochip0' line 17"), std::string::npos)
+      << j.out;
   EXPECT_NE(find(checks, "sound")->message.find("tone was played on ALSA device 'null'"), std::string::npos);
-  EXPECT_NE(find(checks, "sounds")->message.find("all " + std::to_string(stairguide::feedback::all_clip_names().size()) + " cues"), std::string::npos) << j.out;
+  EXPECT_NE(
+      find(checks, "sounds")
+          ->message.find("all " + std::to_string(stairguide::feedback::all_clip_names().size()) + " cues"),
+      std::string::npos)
+      << j.out;
   // ("no daemon running", unless a daemon of another test runs on this machine meanwhile.)
 
   // The plain form says the same to a person: a line per check, the fix under each failure.
@@ -130,8 +136,9 @@ TEST(Doctor, WithTheVirtualCameraAndAFileBuzzerAllIsWell) {
   c.feedback.gpio_chip = "file:" + edges.string();
   const fs::path config = write_config("vcam", c);
   const char* old = std::getenv("LD_LIBRARY_PATH");
-  const std::string env = "LD_LIBRARY_PATH='" + test::vcam_dir() + (old && *old ? std::string(":") + old : "") +
-                          "' SGVCAM_DATASET='" + fs::absolute(dataset).string() + "'";
+  const std::string env = "LD_LIBRARY_PATH='" + test::vcam_dir() +
+                          (old && *old ? std::string(":") + old : "") + "' SGVCAM_DATASET='" +
+                          fs::absolute(dataset).string() + "'";
   const cli_test::CliRun j = doctor(config, "--json", env);
   EXPECT_EQ(j.code, 0) << j.out;
   EXPECT_EQ(failed_list(j.out), "") << j.out;
@@ -204,14 +211,18 @@ TEST(Doctor, AMissingCueAndAMissingUserAreNamed) {
   PipelineConfig c = null_sound_config();
   c.feedback.sounds_dir = sounds.string();
   const fs::path config = write_config("nocue", c);
-  const cli_test::CliRun j = cli_test::run_shell(std::string(STAIRGUIDE_CLI) + " --config '" + config.string() +
-                                                 "' doctor --json --user no-such-stairguide-user");
+  const cli_test::CliRun j =
+      cli_test::run_shell(std::string(STAIRGUIDE_CLI) + " --config '" + config.string() +
+                          "' doctor --json --user no-such-stairguide-user");
   EXPECT_EQ(j.code, 1) << j.out;
   const auto checks = parse_checks(j.out);
   const JsonCheck* s = find(checks, "sounds");
   ASSERT_NE(s, nullptr) << j.out;
   EXPECT_EQ(s->status, "fail");
-  EXPECT_NE(s->message.find("1 of the " + std::to_string(stairguide::feedback::all_clip_names().size()) + " cues"), std::string::npos) << s->message;
+  EXPECT_NE(
+      s->message.find("1 of the " + std::to_string(stairguide::feedback::all_clip_names().size()) + " cues"),
+      std::string::npos)
+      << s->message;
   EXPECT_NE(s->message.find("last_step.wav"), std::string::npos) << s->message;
   const JsonCheck* u = find(checks, "user");
   ASSERT_NE(u, nullptr);
@@ -233,8 +244,9 @@ TEST(Doctor, ARunningDaemonIsNamedAndIsNoFailure) {
   ASSERT_NE(rig, nullptr) << j.out;
   EXPECT_EQ(rig->status, "info");
   // (Other tests' daemons may run on this machine too: the list holds this one.)
-  EXPECT_TRUE(std::regex_search(rig->message, std::regex("stairguided runs outside the service \\(pid [0-9, ]*\\b" +
-                                                           std::to_string(d.pid()) + "\\b")))
+  EXPECT_TRUE(
+      std::regex_search(rig->message, std::regex("stairguided runs outside the service \\(pid [0-9, ]*\\b" +
+                                                 std::to_string(d.pid()) + "\\b")))
       << rig->message;
   EXPECT_EQ(failed_list(j.out).find("rig"), std::string::npos) << j.out;
 }
@@ -253,19 +265,22 @@ TEST(Doctor, TheButtonWhenEnabledAndTheLanguagesWords) {
   auto checks = parse_checks(j.out);
   std::vector<std::string> order;
   for (const auto& k : checks) order.push_back(k.name);
-  EXPECT_EQ(order, (std::vector<std::string>{"config", "camera", "sound", "buzzer", "button", "user", "sounds", "rig"}))
+  EXPECT_EQ(order, (std::vector<std::string>{"config", "camera", "sound", "buzzer", "button", "user",
+                                             "sounds", "rig"}))
       << j.out;
   const JsonCheck* b = find(checks, "button");
   ASSERT_NE(b, nullptr) << j.out;
   EXPECT_EQ(b->status, "fail");
-  EXPECT_NE(b->message.find("cannot use the button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip"),
-            std::string::npos)
+  EXPECT_NE(
+      b->message.find("cannot use the button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip"),
+      std::string::npos)
       << b->message;
   EXPECT_NE(b->fix.find("feedback.button_chip"), std::string::npos) << b->fix;
   const JsonCheck* s = find(checks, "sounds");
   ASSERT_NE(s, nullptr);
   EXPECT_EQ(s->status, "ok") << s->message;
-  EXPECT_NE(s->message.find("(the words in " + std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds/es)"), std::string::npos)
+  EXPECT_NE(s->message.find("(the words in " + std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds/es)"),
+            std::string::npos)
       << s->message;
 
   const fs::path presses = kDir / "doctor.presses";

@@ -68,7 +68,8 @@ TEST(FreshMachine, RefusesADirectoryItDidNotMake) {
   Scratch s;
   ASSERT_FALSE(s.dir.empty());
   fs::create_directories(s.dir / "etc");
-  std::ofstream(s.dir / "etc" / "debian_version") << "12.0\n";  // looks like a Debian root, not made by the tool
+  std::ofstream(s.dir / "etc" / "debian_version")
+      << "12.0\n";  // looks like a Debian root, not made by the tool
   const cli_test::CliRun r = fresh_machine(s.dir.string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("was not made by this script"), std::string::npos) << r.out;

@@ -167,7 +167,8 @@ TEST(CliTraversal, ATruncatedRecordingIsNamedNotASuccess) {
   const long n = lines_of(dir + "/frames.jsonl");
   EXPECT_GT(n, 5);
   EXPECT_LT(n, 30);
-  EXPECT_NE(r.out.find("frame " + std::to_string(n) + " cannot be read"), std::string::npos) << n << " " << r.out;
+  EXPECT_NE(r.out.find("frame " + std::to_string(n) + " cannot be read"), std::string::npos)
+      << n << " " << r.out;
 }
 
 TEST(CliTraversal, AnUnreadableFrameHalfWayIsNamed) {

@@ -325,7 +325,8 @@ TEST(Config, TheDefaultPathIsProbedWithoutOpeningAFifoThere) {
   EXPECT_EQ(probe.get(), fifo);
   EXPECT_THROW(load_config(fifo), ConfigError);
   // A directory is skipped; an absent path is skipped; nothing there gives "" (built-in defaults).
-  EXPECT_EQ(first_config_path({STAIRGUIDE_BINARY_DIR, std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml"}),
+  EXPECT_EQ(first_config_path(
+                {STAIRGUIDE_BINARY_DIR, std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml"}),
             std::string(STAIRGUIDE_SOURCE_DIR) + "/config/stairguide.yaml");
   EXPECT_EQ(first_config_path({std::string(STAIRGUIDE_BINARY_DIR) + "/absent.yaml"}), "");
   std::remove(fifo.c_str());
@@ -338,8 +339,7 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
     const char* what;
   };
   const Case cases[] = {
-      {"floor:\n  usual_height_min_m: 1.4\n  usual_height_max_m: 1.2\n",
-       ":3: key 'floor.usual_height_max_m'",
+      {"floor:\n  usual_height_min_m: 1.4\n  usual_height_max_m: 1.2\n", ":3: key 'floor.usual_height_max_m'",
        "floor.usual_height_min_m must not exceed floor.usual_height_max_m"},
       {"floor:\n  usual_tilt_max_deg: 30\n  usual_tilt_min_deg: 40\n", ":3: key 'floor.usual_tilt_min_deg'",
        "floor.usual_tilt_min_deg must not exceed floor.usual_tilt_max_deg"},
@@ -362,7 +362,8 @@ TEST(Config, EveryMinMaxPairIsOrderedAndNamedAtTheLaterKey) {
     EXPECT_NE(e.find(c.what), std::string::npos) << e;
   }
   // Equal bounds stay allowed where they mean something (a single accepted value).
-  EXPECT_NO_THROW(load_config_text("floor:\n  usual_height_min_m: 1.2\n  usual_height_max_m: 1.2\n", "eq.yaml"));
+  EXPECT_NO_THROW(
+      load_config_text("floor:\n  usual_height_min_m: 1.2\n  usual_height_max_m: 1.2\n", "eq.yaml"));
 }
 
 // The button's and the language's keys: ranges, the buzzer's line refused for the button, a
@@ -376,11 +377,14 @@ TEST(Config, ButtonAndLanguageKeysAreValidated) {
   EXPECT_NE(e.find("test_config_button_line.yaml:3: key 'feedback.button_line'"), std::string::npos) << e;
   EXPECT_NE(e.find("is the buzzer's line"), std::string::npos) << e;
   e = error_of("debounce", "feedback:\n  button_debounce_s: 0.2\n  button_double_press_s: 0.15\n");
-  EXPECT_NE(e.find("feedback.button_debounce_s must be below feedback.button_double_press_s"), std::string::npos) << e;
-  e = error_of("language", "feedback:\n  language: \"../etc\"\n");
-  EXPECT_NE(e.find("test_config_language.yaml:2: key 'feedback.language': feedback.language '../etc' is not a "
-                   "language name"),
+  EXPECT_NE(e.find("feedback.button_debounce_s must be below feedback.button_double_press_s"),
             std::string::npos)
+      << e;
+  e = error_of("language", "feedback:\n  language: \"../etc\"\n");
+  EXPECT_NE(
+      e.find("test_config_language.yaml:2: key 'feedback.language': feedback.language '../etc' is not a "
+             "language name"),
+      std::string::npos)
       << e;
   const PipelineConfig c = load_config_text(
       "feedback:\n  button_enabled: true\n  button_chip: \"file:/tmp/p\"\n  button_long_press_s: 1.5\n"

@@ -267,8 +267,8 @@ TEST_F(DaemonE2E, ABurstOfSighupsOfAnUnchangedConfigLeavesEveryDecisionAsWithout
       if (line.rfind("frame=", 0) != 0) continue;
       auto kv = parse_kv(line);
       std::string keep;
-      for (const char* k : {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left", "known",
-                            "cue"})
+      for (const char* k :
+           {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left", "known", "cue"})
         keep += std::string(k) + "=" + kv[k] + " ";
       out.push_back(keep);
     }
@@ -319,7 +319,8 @@ TEST_F(DaemonE2E, ADatasetWhoseClockJumpsBackIsWarnedAndCountsAsWithAGoodClock) 
       if (line.rfind("frame=", 0) != 0) continue;
       auto kv = parse_kv(line);
       std::string keep;
-      for (const char* k : {"frame", "odom", "perception", "manhattan", "traversal", "step", "left", "known", "cue"})
+      for (const char* k :
+           {"frame", "odom", "perception", "manhattan", "traversal", "step", "left", "known", "cue"})
         keep += std::string(k) + "=" + kv[k] + " ";
       out.push_back(keep);
     }
@@ -341,8 +342,8 @@ TEST_F(DaemonE2E, ADatasetWhoseClockJumpsBackIsWarnedAndCountsAsWithAGoodClock) 
   auto story = [&](const std::vector<std::string>& lines, std::vector<std::string>& cues) {
     std::vector<std::string> states;
     for (const auto& l : lines) {
-      const std::string st = field(l, "traversal") + " step " + field(l, "step") + " left " + field(l, "left") +
-                             " known " + field(l, "known");
+      const std::string st = field(l, "traversal") + " step " + field(l, "step") + " left " +
+                             field(l, "left") + " known " + field(l, "known");
       if (states.empty() || states.back() != st) states.push_back(st);
       if (field(l, "cue") != "-") cues.push_back(field(l, "cue"));
     }
@@ -357,9 +358,10 @@ TEST_F(DaemonE2E, ADatasetWhoseClockJumpsBackIsWarnedAndCountsAsWithAGoodClock) 
     on_flight += good[i].find(" step=0 ") == std::string::npos;
   }
   EXPECT_LE(differ, 4) << "frames whose decision differs from the good clock's";
-  std::printf("%d of %ld frames on a step; with the clock jumping back 5 s at frame 300 the same states, counts and "
-              "cues in the same order, %d frames' decisions one frame apart\n",
-              on_flight, frames, differ);
+  std::printf(
+      "%d of %ld frames on a step; with the clock jumping back 5 s at frame 300 the same states, counts and "
+      "cues in the same order, %d frames' decisions one frame apart\n",
+      on_flight, frames, differ);
   EXPECT_GT(on_flight, 100);
   EXPECT_NE(err.find("frame 300 (#300 of the run): timestamp"), std::string::npos) << err;
   EXPECT_NE(err.find("goes back 4.96"), std::string::npos) << err;
@@ -467,9 +469,10 @@ TEST(SystemdUnit, VerifyPrintsNothingAndSecurityRatingIsAtMost0_8) {
   EXPECT_LE(std::stod(m[1]), 0.8) << out;
 
   // What the daemon relies on is in the unit.
-  for (const char* key : {"Type=notify", "WatchdogSec=", "User=stairguide", "ExecReload=",
-                          "DevicePolicy=closed", "DeviceAllow=char-usb_device rw", "DeviceAllow=char-alsa rw",
-                          "DeviceAllow=char-gpiochip rw", "SupplementaryGroups=audio video gpio", "PrivateMounts=yes"})
+  for (const char* key :
+       {"Type=notify", "WatchdogSec=", "User=stairguide", "ExecReload=", "DevicePolicy=closed",
+        "DeviceAllow=char-usb_device rw", "DeviceAllow=char-alsa rw", "DeviceAllow=char-gpiochip rw",
+        "SupplementaryGroups=audio video gpio", "PrivateMounts=yes"})
     EXPECT_NE(unit.find(key), std::string::npos) << key;
 }
 

@@ -32,7 +32,7 @@ const std::vector<std::string> kStairClips = {
 
 struct Result {
   int code = -1;
-  std::vector<std::string> cues;  // frame-line cue tokens, in frame order
+  std::vector<std::string> cues;                     // frame-line cue tokens, in frame order
   std::vector<std::pair<double, std::string>> told;  // each cue token (split at '+') with its frame's ts
   std::string summary;
   std::vector<std::int16_t> audio;  // (left + right) / 2 of the stereo capture
@@ -94,7 +94,8 @@ Result run_daemon(const std::string& name, const std::string& replay, const std:
 }
 
 bool stair_token(const std::string& t) {
-  return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0 && t.rfind("battery", 0) != 0 && t != "slow";
+  return t != "ready" && t != "blind" && t.rfind("camera", 0) != 0 && t.rfind("battery", 0) != 0 &&
+         t != "slow";
 }
 
 }  // namespace
@@ -179,9 +180,10 @@ TEST(E2eFeedback, MissingSoundDeviceAndGpioChipDaemonGoesOn) {
     f << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir() << "\"\n  gpio_chip: \"gpiochip_sg_absent\"\n";
   }
   std::string out;
-  const std::string cmd = std::string(STAIRGUIDED) + " --config " + conf.string() +
-                          " --replay synth:corridor_static:10 --fast --sync --audio sg_no_such_pcm --no-frame-lines "
-                          "2>&1";
+  const std::string cmd =
+      std::string(STAIRGUIDED) + " --config " + conf.string() +
+      " --replay synth:corridor_static:10 --fast --sync --audio sg_no_such_pcm --no-frame-lines "
+      "2>&1";
   std::FILE* p = popen(cmd.c_str(), "r");
   ASSERT_NE(p, nullptr);
   std::array<char, 4096> buf{};
@@ -247,7 +249,8 @@ TEST(E2eFeedback, ClimbIsToldStepByStep) {
 // file PCM (the stereo stream), and none on the stair-free sequences (StairFreeSequences...).
 TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
   for (const char* walk : {"descend_3_steps", "descend_8_steps"}) {
-    const Result r = run_daemon(std::string("e2e_approach_") + walk, std::string("synth:") + walk, "--realtime");
+    const Result r =
+        run_daemon(std::string("e2e_approach_") + walk, std::string("synth:") + walk, "--realtime");
     ASSERT_EQ(r.code, 0) << r.log;
     std::vector<double> t, d;
     double first_step = -1.0;
@@ -275,7 +278,8 @@ TEST(E2eFeedback, DescentApproachBeepsQuickenAndAreHeard) {
       for (double x : t) EXPECT_LE(x, first_step) << walk;
     }
     // Heard: as many beeps in the file PCM as were given (70 ms each, mixed at once, never dropped).
-    EXPECT_EQ(sgtest::find_all(r.audio, "approach", 0.9).size(), static_cast<std::size_t>(beeps_given)) << walk;
+    EXPECT_EQ(sgtest::find_all(r.audio, "approach", 0.9).size(), static_cast<std::size_t>(beeps_given))
+        << walk;
     EXPECT_EQ(r.stereo.left.size(), r.stereo.right.size());
   }
 }
@@ -360,7 +364,8 @@ std::vector<double> pulses(const std::vector<std::pair<double, int>>& edges) {
 
 bool has_flutter(const std::vector<double>& on) {  // the "muted" pattern: four 40 ms taps in a row
   for (std::size_t i = 0; i + 4 <= on.size(); ++i)
-    if (std::all_of(on.begin() + i, on.begin() + i + 4, [](double ms) { return std::fabs(ms - 40.0) < 15.0; }))
+    if (std::all_of(on.begin() + i, on.begin() + i + 4,
+                    [](double ms) { return std::fabs(ms - 40.0) < 15.0; }))
       return true;
   return false;
 }
@@ -372,21 +377,24 @@ bool has_flutter(const std::vector<double>& on) {  // the "muted" pattern: four 
 // the end of the mute is said ("sound on") and felt (one 150 ms pulse). Presses from a file, as the
 // wearer's fingers would give them, through the whole daemon.
 TEST(E2eFeedback, ButtonAsksMutesAndChangesTheVerbosity) {
-  const std::string presses = press_file("e2e_button", "# short, double, long\n0.5 down\n0.6 up\n"
-                                                       "1.2 down\n1.3 up\n1.45 down\n1.55 up\n"
-                                                       "2.5 down\n3.9 up\n");
-  const Result r = run_daemon("e2e_button", "synth:corridor_static:210", "--realtime", presses + "  mute_s: 2\n");
+  const std::string presses = press_file("e2e_button",
+                                         "# short, double, long\n0.5 down\n0.6 up\n"
+                                         "1.2 down\n1.3 up\n1.45 down\n1.55 up\n"
+                                         "2.5 down\n3.9 up\n");
+  const Result r =
+      run_daemon("e2e_button", "synth:corridor_static:210", "--realtime", presses + "  mute_s: 2\n");
   ASSERT_EQ(r.code, 0) << r.log;
   std::vector<std::string> told;
   for (const auto& c : logged_cues(r.log))
     if (c != "ready") told.push_back(c);
-  EXPECT_EQ(told, (std::vector<std::string>{"where_none", "verbosity_verbose", "muted:2", "unmuted"})) << r.log;
+  EXPECT_EQ(told, (std::vector<std::string>{"where_none", "verbosity_verbose", "muted:2", "unmuted"}))
+      << r.log;
   EXPECT_NE(r.log.find("button: reading presses on file:"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("button: short press"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("button: double press"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("button: long press"), std::string::npos) << r.log;
-  const auto names =
-      sgtest::names_of(sgtest::heard(r.audio, {"ready", "no_stairs", "verbose", "muted", "unmuted", "normal"}));
+  const auto names = sgtest::names_of(
+      sgtest::heard(r.audio, {"ready", "no_stairs", "verbose", "muted", "unmuted", "normal"}));
   std::printf("button: told %s; heard %s\n", ::testing::PrintToString(told).c_str(),
               ::testing::PrintToString(names).c_str());
   EXPECT_EQ(names, (std::vector<std::string>{"ready", "no_stairs", "verbose", "muted", "unmuted"}));
@@ -415,7 +423,8 @@ TEST(E2eFeedback, ButtonAsksMutesAndChangesTheVerbosity) {
 // position), heard from the stairs' clips: "stairs ahead, going up" twice (told, then answered).
 TEST(E2eFeedback, ButtonShortPressSaysWhereTheStairsAre) {
   const std::string presses = press_file("e2e_button_where", "2.5 down\n2.6 up\n");
-  const Result r = run_daemon("e2e_button_where", "synth:ascending_approach_climb:120", "--realtime", presses);
+  const Result r =
+      run_daemon("e2e_button_where", "synth:ascending_approach_climb:120", "--realtime", presses);
   ASSERT_EQ(r.code, 0) << r.log;
   std::vector<std::string> where;
   for (const auto& c : logged_cues(r.log))
@@ -443,7 +452,8 @@ TEST(E2eFeedback, MutedDescentStillWarns) {
   int warnings = 0;
   for (const auto& c : told) {
     warnings += c.rfind("drop_warning_down", 0) == 0;
-    EXPECT_TRUE(c.rfind("drop_warning", 0) == 0 || c.rfind("approach", 0) == 0 || c == "muted:60" || c == "ready")
+    EXPECT_TRUE(c.rfind("drop_warning", 0) == 0 || c.rfind("approach", 0) == 0 || c == "muted:60" ||
+                c == "ready")
         << c;
   }
   EXPECT_EQ(warnings, 1) << ::testing::PrintToString(told);
@@ -454,8 +464,9 @@ TEST(E2eFeedback, MutedDescentStillWarns) {
 TEST(E2eFeedback, MissingButtonChipIsNamedAndTheDaemonGoesOn) {
   fs::create_directories(kDir);
   const fs::path conf = kDir / "e2e_nobutton.yaml";
-  std::ofstream(conf) << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir()
-                      << "\"\n  button_enabled: true\n  button_chip: \"gpiochip_sg_absent\"\n  button_line: 5\n";
+  std::ofstream(conf)
+      << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir()
+      << "\"\n  button_enabled: true\n  button_chip: \"gpiochip_sg_absent\"\n  button_line: 5\n";
   std::string out;
   const std::string cmd = std::string(STAIRGUIDED) + " --config " + conf.string() +
                           " --replay synth:corridor_static:10 --fast --sync --audio null --no-haptic 2>&1";
@@ -465,7 +476,8 @@ TEST(E2eFeedback, MissingButtonChipIsNamedAndTheDaemonGoesOn) {
   while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
   const int st = pclose(p);
   EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 0) << out;
-  EXPECT_NE(out.find("button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip ("), std::string::npos)
+  EXPECT_NE(out.find("button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip ("),
+            std::string::npos)
       << out;
   EXPECT_NE(out.find("going on without the button"), std::string::npos) << out;
   EXPECT_NE(out.find("summary frames=10"), std::string::npos) << out;

@@ -26,8 +26,8 @@ const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_feedback_drops_file
 struct DaemonRun {
   int code = -1;
   std::vector<std::pair<double, std::string>> told;  // each cue token with its frame's timestamp
-  std::vector<std::int16_t> audio;                  // (left + right) / 2
-  std::vector<std::pair<double, int>> edges;        // buzzer: ms, level
+  std::vector<std::int16_t> audio;                   // (left + right) / 2
+  std::vector<std::pair<double, int>> edges;         // buzzer: ms, level
   std::string log;
 };
 
@@ -39,11 +39,12 @@ DaemonRun run_daemon(const std::string& name, const std::string& replay) {
   fs::remove(kDir / (name + ".raw"));
   {
     std::ofstream f(conf);
-    f << "feedback:\n  audio_device: \"default\"\n  sounds_dir: \"" << sgtest::sounds_dir() << "\"\n  gpio_chip: \"file:"
-      << edges.string() << "\"\n";
+    f << "feedback:\n  audio_device: \"default\"\n  sounds_dir: \"" << sgtest::sounds_dir()
+      << "\"\n  gpio_chip: \"file:" << edges.string() << "\"\n";
   }
-  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " + conf.string() +
-                          " --replay " + replay + " --audio " + name + " --fast --sync 2>" + err.string();
+  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " +
+                          conf.string() + " --replay " + replay + " --audio " + name + " --fast --sync 2>" +
+                          err.string();
   DaemonRun r;
   std::FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -79,7 +80,8 @@ DaemonRun run_daemon(const std::string& name, const std::string& replay) {
 TEST(E2eFeedbackDrops, WalkTowardsAPlatformEdgeSaysDropAheadBeforeTheEdge) {
   const std::string preset = "drop_platform_walk";
   const std::uint32_t seed = 7;
-  const DaemonRun r = run_daemon("e2e_drop_walk", "synth:" + preset + ":460:" + std::to_string(seed) + ":real-v1");
+  const DaemonRun r =
+      run_daemon("e2e_drop_walk", "synth:" + preset + ":460:" + std::to_string(seed) + ":real-v1");
   ASSERT_EQ(r.code, 0) << r.log;
   std::vector<std::pair<double, std::string>> drops;
   int beeps = 0;
@@ -109,7 +111,8 @@ TEST(E2eFeedbackDrops, WalkTowardsAPlatformEdgeSaysDropAheadBeforeTheEdge) {
   EXPECT_GE(std::atoi(drops[0].second.c_str() + std::strlen("drop_ahead:")), 1) << drops[0].second;
   EXPECT_GE(beeps, 3);
   // Heard: the alarm and the words, in that order.
-  const auto names = sgtest::names_of(sgtest::heard(r.audio, {"drop_ahead", "warning", "stairs_down", "stairs_up"}));
+  const auto names =
+      sgtest::names_of(sgtest::heard(r.audio, {"drop_ahead", "warning", "stairs_down", "stairs_up"}));
   std::printf("heard %s\n", ::testing::PrintToString(names).c_str());
   ASSERT_EQ(std::count(names.begin(), names.end(), "drop_ahead"), static_cast<long>(drops.size()))
       << ::testing::PrintToString(names);
@@ -119,15 +122,17 @@ TEST(E2eFeedbackDrops, WalkTowardsAPlatformEdgeSaysDropAheadBeforeTheEdge) {
   // Felt: four strong pulses of 150 ms per drop told (and the 150 ms pulse of "ready").
   int strong = 0;
   for (std::size_t i = 1; i < r.edges.size(); ++i)
-    if (r.edges[i - 1].second == 1 && r.edges[i].second == 0 && std::fabs(r.edges[i].first - r.edges[i - 1].first - 150.0) < 20.0)
+    if (r.edges[i - 1].second == 1 && r.edges[i].second == 0 &&
+        std::fabs(r.edges[i].first - r.edges[i - 1].first - 150.0) < 20.0)
       ++strong;
   EXPECT_EQ(strong, 4 * static_cast<int>(drops.size()) + 1);
 }
 
 TEST(E2eFeedbackDrops, StairFreeWalksSayNoDrop) {
   const fs::path kitchen = fs::path(STAIRGUIDE_SHARED_DATA) / "7scenes-redkitchen-0000-0299";
-  std::vector<std::pair<std::string, std::string>> runs = {{"e2e_drop_room", "synth:room_clutter_static:60:5:real-v1"},
-                                                           {"e2e_drop_corridor", "synth:corridor_static:60:5:real-v2"}};
+  std::vector<std::pair<std::string, std::string>> runs = {
+      {"e2e_drop_room", "synth:room_clutter_static:60:5:real-v1"},
+      {"e2e_drop_corridor", "synth:corridor_static:60:5:real-v2"}};
   if (fs::exists(kitchen))
     runs.push_back({"e2e_drop_kitchen", kitchen.string()});
   else

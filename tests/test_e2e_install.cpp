@@ -56,7 +56,8 @@ void expect_installed_paths_agree(const std::string& prefix) {
   EXPECT_EQ(c.feedback.sounds_dir, prefix + "/share/stairguide/sounds");
   const fs::path sounds = d.dir / fs::path(c.feedback.sounds_dir).relative_path();
   ASSERT_TRUE(fs::is_directory(sounds)) << sounds;
-  const feedback::SoundBank bank = feedback::load_sound_bank(sounds.string(), feedback::all_clip_names(), 1.0f);
+  const feedback::SoundBank bank =
+      feedback::load_sound_bank(sounds.string(), feedback::all_clip_names(), 1.0f);
   EXPECT_TRUE(bank.problems.empty()) << bank.problems.front();
   EXPECT_EQ(bank.clips.size(), feedback::all_clip_names().size());
   // Only that line differs from the source tree's config (its comment kept).
@@ -66,20 +67,23 @@ void expect_installed_paths_agree(const std::string& prefix) {
   EXPECT_EQ(read_file(config), source);
 
   // The unit starts the launcher this install put under the prefix.
-  const std::string unit = read_file(d.dir / fs::path(prefix).relative_path() / "lib/systemd/system/stairguide.service");
+  const std::string unit =
+      read_file(d.dir / fs::path(prefix).relative_path() / "lib/systemd/system/stairguide.service");
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(unit, m, std::regex("\nExecStart=(\\S+) --config /etc/stairguide/stairguide.yaml\n")))
+  ASSERT_TRUE(
+      std::regex_search(unit, m, std::regex("\nExecStart=(\\S+) --config /etc/stairguide/stairguide.yaml\n")))
       << unit;
   EXPECT_EQ(m[1].str(), prefix + "/bin/stairguided");
   const fs::path launcher = d.dir / fs::path(m[1].str()).relative_path();
   ASSERT_TRUE(fs::exists(launcher));
   EXPECT_TRUE(fs::exists(d.dir / fs::path(prefix).relative_path() / "lib/sysusers.d/stairguide.conf"));
-  EXPECT_TRUE(fs::exists(d.dir / fs::path(prefix).relative_path() / "lib/udev/rules.d/60-stairguide-gpio.rules"));
+  EXPECT_TRUE(
+      fs::exists(d.dir / fs::path(prefix).relative_path() / "lib/udev/rules.d/60-stairguide-gpio.rules"));
 
   // The launcher runs the daemon installed beside it (found relative to itself, so even staged
   // under DESTDIR), which accepts the installed config.
-  const cli_test::CliRun check = cli_test::run_shell("'" + launcher.string() + "' --check-config '" +
-                                                     config.string() + "'");
+  const cli_test::CliRun check =
+      cli_test::run_shell("'" + launcher.string() + "' --check-config '" + config.string() + "'");
   EXPECT_EQ(check.code, 0) << check.out;
   EXPECT_NE(check.out.find(": ok"), std::string::npos) << check.out;
 }

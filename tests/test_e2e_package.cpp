@@ -80,10 +80,12 @@ struct RestoreAtEnd {
 }  // namespace
 
 TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
-  if (geteuid() != 0) GTEST_SKIP() << "needs root: it installs the package into this system with dpkg (CI runs as root)";
+  if (geteuid() != 0)
+    GTEST_SKIP() << "needs root: it installs the package into this system with dpkg (CI runs as root)";
   if (sh("command -v dpkg && command -v systemd-analyze && command -v setpriv").code != 0)
     GTEST_SKIP() << "needs dpkg, systemd-analyze and setpriv (Debian's dpkg, systemd, util-linux)";
-  if (dpkg_busy()) GTEST_SKIP() << "dpkg is busy (another apt or dpkg holds its lock): try again when it is done";
+  if (dpkg_busy())
+    GTEST_SKIP() << "dpkg is busy (another apt or dpkg holds its lock): try again when it is done";
   const cli_test::CliRun known = sh("dpkg-query -W -f='${Status}' stairguide");
   if (known.code == 0 && known.out.find("not-installed") == std::string::npos)
     GTEST_SKIP() << "a stairguide package is on this machine (" << known.out
@@ -98,7 +100,8 @@ TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
   ASSERT_EQ(pkg.code, 0) << pkg.out;
   const double built = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(pkg.out, m, std::regex("(\\S+/stairguide_[0-9.]+_[a-z0-9]+\\.deb)\n?$"))) << pkg.out;
+  ASSERT_TRUE(std::regex_search(pkg.out, m, std::regex("(\\S+/stairguide_[0-9.]+_[a-z0-9]+\\.deb)\n?$")))
+      << pkg.out;
   const std::string deb = m[1];
   EXPECT_NE(pkg.out.find("lintian: no errors"), std::string::npos) << pkg.out;
   const cli_test::CliRun fields = sh("dpkg-deb -f '" + deb + "' Depends");
@@ -120,9 +123,10 @@ TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
     EXPECT_NE((" " + groups.out).find(std::string(" ") + g), std::string::npos) << groups.out;
   EXPECT_FALSE(fs::exists("/etc/systemd/system/multi-user.target.wants/stairguide.service"))
       << "installing enabled the service";
-  for (const char* f : {"/usr/bin/stairguide", "/usr/bin/stairguided", "/usr/libexec/stairguide/stairguided-core",
-                        "/usr/share/stairguide/sounds/last_step.wav", "/lib/systemd/system/stairguide.service",
-                        "/usr/lib/sysusers.d/stairguide.conf", "/lib/udev/rules.d/60-stairguide-gpio.rules"})
+  for (const char* f :
+       {"/usr/bin/stairguide", "/usr/bin/stairguided", "/usr/libexec/stairguide/stairguided-core",
+        "/usr/share/stairguide/sounds/last_step.wav", "/lib/systemd/system/stairguide.service",
+        "/usr/lib/sysusers.d/stairguide.conf", "/lib/udev/rules.d/60-stairguide-gpio.rules"})
     EXPECT_TRUE(fs::exists(f)) << f;
   const std::string config = read_file("/etc/stairguide/stairguide.yaml");
   EXPECT_NE(config.find("sounds_dir: \"/usr/share/stairguide/sounds\""), std::string::npos);
@@ -137,15 +141,19 @@ TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
   // installed config; the cues go to an ALSA file PCM (this machine has no sound card) and must be
   // heard from the installed sounds: the daemon is not mute (defect 8).
   const fs::path wav = s.dir / "cues.wav";
-  std::ofstream(s.dir / "asound.conf") << "pcm.cues { type file  slave.pcm { type null }  file \"" << wav.string()
-                                       << "\"  format \"wav\" }\n";
+  std::ofstream(s.dir / "asound.conf")
+      << "pcm.cues { type file  slave.pcm { type null }  file \"" << wav.string() << "\"  format \"wav\" }\n";
   const cli_test::CliRun replay =
-      sh("cd / && setpriv --reuid=stairguide --regid=stairguide --init-groups --reset-env env ALSA_CONFIG_PATH='" +
+      sh("cd / && setpriv --reuid=stairguide --regid=stairguide --init-groups --reset-env env "
+         "ALSA_CONFIG_PATH='" +
          (s.dir / "asound.conf").string() +
-         "' /usr/bin/stairguided --replay synth:ascending_approach_climb:120:1 --sync --fast --no-haptic --audio cues");
+         "' /usr/bin/stairguided --replay synth:ascending_approach_climb:120:1 --sync --fast --no-haptic "
+         "--audio cues");
   const std::string tail = replay.out.substr(replay.out.size() > 4000 ? replay.out.size() - 4000 : 0);
   EXPECT_EQ(replay.code, 0) << tail;
-  ASSERT_TRUE(std::regex_search(replay.out, m, std::regex("summary frames=(\\d+) .* cues=(\\d+) cues_sounded=(\\d+) .* last_cue=(\\S+)")))
+  ASSERT_TRUE(std::regex_search(
+      replay.out, m,
+      std::regex("summary frames=(\\d+) .* cues=(\\d+) cues_sounded=(\\d+) .* last_cue=(\\S+)")))
       << tail;
   EXPECT_EQ(m[1].str(), "120");
   EXPECT_GE(std::stoi(m[2]), 2) << "ready, then stairs ahead";
@@ -158,8 +166,10 @@ TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
   // The doctor of the installed tool finds what the package provides: config, user, sounds.
   const cli_test::CliRun doc = sh("/usr/bin/stairguide doctor --json");
   for (const char* name : {"config", "user", "sounds"})
-    EXPECT_TRUE(std::regex_search(doc.out, std::regex(std::string("\"name\": \"") + name + "\", \"status\": \"ok\"")))
-        << name << ":\n" << doc.out;
+    EXPECT_TRUE(
+        std::regex_search(doc.out, std::regex(std::string("\"name\": \"") + name + "\", \"status\": \"ok\"")))
+        << name << ":\n"
+        << doc.out;
 
   // Remove: the programs go, the config stays.
   const cli_test::CliRun rm = sh("dpkg -r stairguide");
@@ -172,13 +182,14 @@ TEST(DebianPackage, BuildsInstallsVerifiesRunsAsTheServiceUserAndPurgesClean) {
   const cli_test::CliRun purged = sh("dpkg --purge stairguide");
   ASSERT_EQ(purged.code, 0) << purged.out;
   restore.purge = false;
-  for (const char* f : {"/etc/stairguide", "/usr/bin/stairguide", "/usr/bin/stairguided", "/usr/libexec/stairguide",
-                        "/usr/share/stairguide", "/usr/share/doc/stairguide", "/lib/systemd/system/stairguide.service",
-                        "/usr/lib/sysusers.d/stairguide.conf", "/lib/udev/rules.d/60-stairguide-gpio.rules",
-                        "/var/lib/stairguide"})
+  for (const char* f : {"/etc/stairguide", "/usr/bin/stairguide", "/usr/bin/stairguided",
+                        "/usr/libexec/stairguide", "/usr/share/stairguide", "/usr/share/doc/stairguide",
+                        "/lib/systemd/system/stairguide.service", "/usr/lib/sysusers.d/stairguide.conf",
+                        "/lib/udev/rules.d/60-stairguide-gpio.rules", "/var/lib/stairguide"})
     EXPECT_FALSE(fs::exists(f)) << f << " is left after purge";
   EXPECT_EQ(sh("dpkg-query -W stairguide").code, 1) << "dpkg still knows the package";
 
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("package test: %.0f s (package built in %.0f s, replay done at %.0f s)\n", took, built, replayed);
+  std::printf("package test: %.0f s (package built in %.0f s, replay done at %.0f s)\n", took, built,
+              replayed);
 }

@@ -118,7 +118,7 @@ TEST(FeedbackAlsa, CuesHeardInOrderThroughAFilePcm) {
     };
     AlsaSinkOptions o;
     o.device = "sg_order";
-    o.stereo = false;  // the very samples of the WAVs
+    o.stereo = false;    // the very samples of the WAVs
     o.max_age_s = 10.0;  // the three wait behind each other longer than the default 3 s
     AlsaAudioSink sink(o, bank(), ev);
     const auto t0 = SteadyClock::now();
@@ -306,10 +306,10 @@ TEST(FeedbackAlsa, EarconIsMixedOverAPhraseAtOnce) {
   const auto cap = sgtest::read_raw(kDir / "sg_mix.raw");
   ASSERT_GE(cap.size(), phrase.size());
   long at = -1;
-  for (long k = kChunk; k + static_cast<long>(tick.size()) <= static_cast<long>(phrase.size()) && at < 0; k += kChunk) {
+  for (long k = kChunk; k + static_cast<long>(tick.size()) <= static_cast<long>(phrase.size()) && at < 0;
+       k += kChunk) {
     bool all = true;
-    for (std::size_t i = 0; i < tick.size() && all; ++i)
-      all = cap[k + i] == sat(phrase[k + i] / 2 + tick[i]);
+    for (std::size_t i = 0; i < tick.size() && all; ++i) all = cap[k + i] == sat(phrase[k + i] / 2 + tick[i]);
     if (all) at = k;
   }
   ASSERT_GE(at, 0) << "no chunk holds the phrase with the tick mixed over it";
@@ -446,10 +446,12 @@ TEST(FeedbackAlsa, CuesArePannedByTheStaircasesBearing) {
     pan_gains(cue_pan(e), gl, gr);
     long off = 0;
     for (long j = 0; j < len; ++j)
-      off += st.left[from + j] != std::lround(clip[j] * gl) || st.right[from + j] != std::lround(clip[j] * gr);
+      off +=
+          st.left[from + j] != std::lround(clip[j] * gl) || st.right[from + j] != std::lround(clip[j] * gr);
     EXPECT_EQ(off, 0) << i;
   }
-  std::printf("right - left: 3 o'clock %+.1f dB, 9 o'clock %+.1f dB, 12 o'clock %+.1f dB\n", db[0], db[1], db[2]);
+  std::printf("right - left: 3 o'clock %+.1f dB, 9 o'clock %+.1f dB, 12 o'clock %+.1f dB\n", db[0], db[1],
+              db[2]);
   EXPECT_GE(db[0], 6.0);
   EXPECT_LE(db[1], -6.0);
   EXPECT_NEAR(db[2], 0.0, 0.01);
@@ -500,7 +502,8 @@ TEST(FeedbackSounds, EveryLanguageHasEveryWord) {
     const std::string dir = sgtest::sounds_dir() + "/" + l;
     const SoundBank b = load_sound_bank(dir, words, 1.0f);
     EXPECT_TRUE(b.problems.empty()) << l << ": " << ::testing::PrintToString(b.problems);
-    for (const auto& [name, s] : b.clips) EXPECT_LE(static_cast<double>(s.size()) / kSoundRate, 2.0) << l << "/" << name;
+    for (const auto& [name, s] : b.clips)
+      EXPECT_LE(static_cast<double>(s.size()) / kSoundRate, 2.0) << l << "/" << name;
     std::size_t files = 0;
     for (const auto& e : fs::directory_iterator(dir)) {
       ++files;

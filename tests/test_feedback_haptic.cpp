@@ -95,7 +95,8 @@ TEST(FeedbackHaptic, PatternsEdgesWithin5ms) {
         ASSERT_EQ(edges[i].on, want[i].second) << token(e) << " edge " << i;
         const double from_start = ms(edges[0].t, edges[i].t) - want[i].first;
         // each duration too, not only the sum
-        const double duration = i ? ms(edges[i - 1].t, edges[i].t) - (want[i].first - want[i - 1].first) : 0.0;
+        const double duration =
+            i ? ms(edges[i - 1].t, edges[i].t) - (want[i].first - want[i - 1].first) : 0.0;
         if (std::abs(from_start) > 5.0 || std::abs(duration) > 5.0) {
           timed_right = false;
           worst = token(e) + " edge " + std::to_string(i) + ": " + std::to_string(from_start) +
@@ -138,8 +139,10 @@ TEST(FeedbackHaptic, DangerCutsATickAndATickDoesNotCutDanger) {
     ASSERT_GT(ms(e[0].t, e[1].t), 190.0);
     ASSERT_FALSE(e.back().on);
     off.clear();
-    if (std::abs(ms(t_cut, e[1].t)) > 5.0) off += " cut " + std::to_string(ms(t_cut, e[1].t)) + " ms after the call;";
-    if (std::abs(ms(e[1].t, e[2].t) - 100.0) > 5.0) off += " gap " + std::to_string(ms(e[1].t, e[2].t)) + " ms;";
+    if (std::abs(ms(t_cut, e[1].t)) > 5.0)
+      off += " cut " + std::to_string(ms(t_cut, e[1].t)) + " ms after the call;";
+    if (std::abs(ms(e[1].t, e[2].t) - 100.0) > 5.0)
+      off += " gap " + std::to_string(ms(e[1].t, e[2].t)) + " ms;";
     for (std::size_t i = 0; i < want.size(); ++i) {
       ASSERT_EQ(e[2 + i].on, want[i].second) << i;
       if (std::abs(ms(e[2].t, e[2 + i].t) - want[i].first) > 5.0)

@@ -523,8 +523,9 @@ TEST(FeedbackPolicy, ApproachBeepQuickensAsTheEdgeNears) {
     b.insert(b.begin(), warned);
     std::vector<double> gaps;
     for (std::size_t i = 1; i < b.size(); ++i) gaps.push_back(b[i] - b[i - 1]);
-    for (std::size_t i = 1; i < gaps.size(); ++i) EXPECT_LE(gaps[i], gaps[i - 1] + 1e-9) << noise << " beep " << i;
-    EXPECT_GT(gaps.front(), 0.9) << noise;  // far: slow (1.5 s at 2 m, less as it nears)
+    for (std::size_t i = 1; i < gaps.size(); ++i)
+      EXPECT_LE(gaps[i], gaps[i - 1] + 1e-9) << noise << " beep " << i;
+    EXPECT_GT(gaps.front(), 0.9) << noise;                // far: slow (1.5 s at 2 m, less as it nears)
     EXPECT_NEAR(gaps.back(), 0.25, kDt + 1e-9) << noise;  // at and nearer than 0.5 m: 0.25 s
     // The distance it beeps for goes down with the beeps.
     float last = 1e9f;
@@ -857,7 +858,8 @@ TEST(FeedbackButton, AnswersUseKnownClips) {
   auto known = [&](const std::string& n) { return std::find(all.begin(), all.end(), n) != all.end(); };
   for (Cue c : {Cue::kWhere, Cue::kMuted, Cue::kUnmuted, Cue::kVerbosity})
     for (int number : {-1, 0, 1, 2, 4})
-      for (StairKind k : {StairKind::kNone, StairKind::kAscending, StairKind::kCurb, StairKind::kSingleStep}) {
+      for (StairKind k :
+           {StairKind::kNone, StairKind::kAscending, StairKind::kCurb, StairKind::kSingleStep}) {
         CueEvent e;
         e.cue = c;
         e.number = number;
@@ -903,7 +905,8 @@ TEST(FeedbackPolicy, DropAheadToldOnceThenBeeps) {
       if (x.e.cue == Cue::kDropAhead) {
         EXPECT_NEAR(x.t, 1.5, 0.1) << verbosity;  // at 2 m, as the walk crosses danger_distance
         EXPECT_GT(cue_pan(x.e), 0.5f);            // from the right
-        EXPECT_EQ(clips_for(x.e), (std::vector<std::string>{"warning", "drop_ahead", "n2", "metres", "n2", "oclock"}));
+        EXPECT_EQ(clips_for(x.e),
+                  (std::vector<std::string>{"warning", "drop_ahead", "n2", "metres", "n2", "oclock"}));
       }
   }
   // Straight ahead: the beeps quicken as the edge nears (the cone is 35 deg).

@@ -385,10 +385,11 @@ TEST(DenseOdometrySequence, RealKitchenNotWorseThanReference) {
                   ref = relative_pose_error(run.ref, run.truth);
   const double ate_ours = absolute_trajectory_error(run.ours, run.truth).rmse(),
                ate_ref = absolute_trajectory_error(run.ref, run.truth).rmse();
-  std::printf("7-Scenes kitchen, 300 frames: RPE ours %.4f m/s %.3f deg/s ATE %.4f m, reference %.4f m/s %.3f "
-              "deg/s ATE %.4f m\n",
-              ours.translation_m_s.rmse(), ours.rotation_deg_s.rmse(), ate_ours, ref.translation_m_s.rmse(),
-              ref.rotation_deg_s.rmse(), ate_ref);
+  std::printf(
+      "7-Scenes kitchen, 300 frames: RPE ours %.4f m/s %.3f deg/s ATE %.4f m, reference %.4f m/s %.3f "
+      "deg/s ATE %.4f m\n",
+      ours.translation_m_s.rmse(), ours.rotation_deg_s.rmse(), ate_ours, ref.translation_m_s.rmse(),
+      ref.rotation_deg_s.rmse(), ate_ref);
   EXPECT_EQ(run.failures, 0);
   EXPECT_LE(ours.translation_m_s.rmse(), ref.translation_m_s.rmse());
   EXPECT_LE(ours.rotation_deg_s.rmse(), ref.rotation_deg_s.rmse());

@@ -70,8 +70,8 @@ void draw_segment(Drawing& d, const Eigen::Vector3f& a, const Eigen::Vector3f& b
     const Eigen::Vector3f q = a + (b - a) * (static_cast<float>(i + 1) / kPieces);
     cv::Point2f pi, qi;
     if (!project(p, pi) || !project(q, qi)) continue;
-    cv::line(d.gray, cv::Point(cvRound(pi.x * 16), cvRound(pi.y * 16)), cv::Point(cvRound(qi.x * 16), cvRound(qi.y * 16)),
-             cv::Scalar(shade), 2, cv::LINE_AA, 4);
+    cv::line(d.gray, cv::Point(cvRound(pi.x * 16), cvRound(pi.y * 16)),
+             cv::Point(cvRound(qi.x * 16), cvRound(qi.y * 16)), cv::Scalar(shade), 2, cv::LINE_AA, 4);
   }
 }
 
@@ -125,7 +125,8 @@ TEST(EdgeCompass, VerticalEdgesSayNothing) {
   const float yaw = 20.f * kDeg;
   const Eigen::Vector3f along(std::cos(yaw), 0.f, -std::sin(yaw));
   for (float h : {0.1f, 0.5f, 0.9f, 1.2f, 1.5f})
-    draw_segment(d, Eigen::Vector3f(0.f, h, 3.f) - 3.f * along, Eigen::Vector3f(0.f, h, 3.f) + 3.f * along, 30);
+    draw_segment(d, Eigen::Vector3f(0.f, h, 3.f) - 3.f * along, Eigen::Vector3f(0.f, h, 3.f) + 3.f * along,
+                 30);
   const EdgeCompassResult r = compass.estimate(d.gray, d.K, d.R);
   ASSERT_TRUE(r.valid);
   EXPECT_LT(std::fabs(sg_test::wrap45(r.yaw - yaw)) / kDeg, 0.5f) << "compass " << r.yaw / kDeg;
@@ -139,7 +140,8 @@ TEST(EdgeCompass, TextureWithoutStraightEdgesHasNoDirection) {
   std::mt19937 rng(7);
   cv::Mat noise(d.K.height / 4, d.K.width / 4, CV_8UC1);
   for (int v = 0; v < noise.rows; ++v)
-    for (int u = 0; u < noise.cols; ++u) noise.at<unsigned char>(v, u) = static_cast<unsigned char>(rng() % 256);
+    for (int u = 0; u < noise.cols; ++u)
+      noise.at<unsigned char>(v, u) = static_cast<unsigned char>(rng() % 256);
   cv::resize(noise, d.gray, d.gray.size(), 0, 0, cv::INTER_CUBIC);
   const EdgeCompassResult r = compass.estimate(d.gray, d.K, d.R);
   EXPECT_LT(r.support, 0.5f * ManhattanConfig{}.compass_min_support) << r.edgels << " edgels";
@@ -196,14 +198,15 @@ TEST(EdgeCompassRealData, KitchenEdgesAgreeWithTheWalls) {
     ASSERT_TRUE(r.valid) << "view " << i;
     EXPECT_GE(r.support, ManhattanConfig{}.compass_min_support) << "view " << i;
     const float diff = std::fabs(sg_test::wrap45(r.yaw - sc.manhattan_yaw)) / kDeg;
-    EXPECT_LE(diff, 2.5f) << "view " << i << ": compass " << r.yaw / kDeg << " deg, planes " << sc.manhattan_yaw / kDeg;
+    EXPECT_LE(diff, 2.5f) << "view " << i << ": compass " << r.yaw / kDeg << " deg, planes "
+                          << sc.manhattan_yaw / kDeg;
     ++compared;
     worst = std::max(worst, diff);
     sum += diff;
   }
   // Measured: 32 views (0-155), support 0.31-0.59, within 1.79 degrees (mean 0.89) of the planes.
-  std::printf("kitchen: compass on %d views, within %.2f deg of the planes' frame (mean %.2f)\n", compared, worst,
-              compared ? sum / compared : 0.f);
+  std::printf("kitchen: compass on %d views, within %.2f deg of the planes' frame (mean %.2f)\n", compared,
+              worst, compared ? sum / compared : 0.f);
   EXPECT_GE(compared, 25);
 }
 

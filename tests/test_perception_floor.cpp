@@ -22,9 +22,10 @@ TEST(PerceptionFloor, NeverATreadOnOtherSeeds) {
   SceneResult scene;
   int views = 0, visible = 0, found = 0, wrong = 0;
   for (std::uint32_t seed : {6u, 7u}) {
-    for (const char* preset : {"ascending_static", "ascending_short_static", "descending_static", "open_risers_static",
-                               "nosing_landing_static", "rotated_static", "people_static",
-                               "handrails_open_sides_static", "single_step_static", "curb_static"}) {
+    for (const char* preset :
+         {"ascending_static", "ascending_short_static", "descending_static", "open_risers_static",
+          "nosing_landing_static", "rotated_static", "people_static", "handrails_open_sides_static",
+          "single_step_static", "curb_static"}) {
       for (long i = 0; i < 16; ++i) {
         synth::render_preset_frame(preset, i, seed, synth::SynthOptions{}, frame, truth);
         perception.reset();  // independent views: nothing tracked
@@ -171,8 +172,8 @@ TEST(PerceptionFloor, TheFirstTreadInAStairwellIsNoFloor) {
   ASSERT_FALSE(truth.stairs.empty()) << "the world changed";
   if (scene.floor_found) {
     EXPECT_LE(std::fabs(scene.camera_height - truth.camera_height_m), 0.02f)
-        << "a tread taken for the floor (floor at " << scene.camera_height << " m, truth " << truth.camera_height_m
-        << " m)";
+        << "a tread taken for the floor (floor at " << scene.camera_height << " m, truth "
+        << truth.camera_height_m << " m)";
   }
 }
 
@@ -192,12 +193,14 @@ TEST(PerceptionFloor, TheFloorOfAStairwellDeeperThanATreadIsKept) {
 void expect_user_on_level_above(const char* preset, long index, std::uint32_t seed) {
   FrameTruth truth;
   const SceneResult scene = cold_view(preset, index, seed, truth);
-  EXPECT_FALSE(scene.floor_found) << preset << " " << index << ": floor at " << scene.camera_height << " m, truth "
-                                  << truth.camera_height_m << " m";
+  EXPECT_FALSE(scene.floor_found) << preset << " " << index << ": floor at " << scene.camera_height
+                                  << " m, truth " << truth.camera_height_m << " m";
   EXPECT_NE(scene.why.find("level above"), std::string::npos) << scene.why;
 }
 
-TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) { expect_user_on_level_above("curb_static", 4, 2u); }
+TEST(PerceptionFloor, UserOnTheLevelAboveAtTheViewsEdgeIsNoFloor) {
+  expect_user_on_level_above("curb_static", 4, 2u);
+}
 
 // The same from near the view's corner (held-out seed 20): the user's level shows as a triangle
 // cut by the view's left and bottom borders, and its edge with the road runs 0.54 m between them,
@@ -211,7 +214,8 @@ TEST(PerceptionFloor, UserOnTheLevelAboveSeenInTheViewsCornerIsNoFloor) {
 // the view's bottom edge, 0.166 m above the floor, with a straight 1.2 m edge, but the nadir lies
 // on the floor's side of that edge (about 1 m): the user stands on the floor, which is found.
 TEST(PerceptionFloor, AStepAtTheViewsEdgeAheadKeepsTheFloor) {
-  expect_floor_found("single_step_static", 11, "a step at the view's edge, the nadir on the floor's side", 3u);
+  expect_floor_found("single_step_static", 11, "a step at the view's edge, the nadir on the floor's side",
+                     3u);
 }
 
 }  // namespace

@@ -29,8 +29,8 @@ struct Case {
   std::uint32_t seed;
 };
 
-View run_view(const std::string& preset, long index, std::uint32_t seed, const ManhattanConfig& manhattan = {},
-              const synth::SynthOptions& options = {}) {
+View run_view(const std::string& preset, long index, std::uint32_t seed,
+              const ManhattanConfig& manhattan = {}, const synth::SynthOptions& options = {}) {
   View v;
   RgbdFrame frame;
   synth::render_preset_frame(preset, index, seed, options, frame, v.truth);
@@ -43,7 +43,8 @@ View run_view(const std::string& preset, long index, std::uint32_t seed, const M
 // The view shows at least `min_wall_px` of wall or riser and gets a frame within 2 degrees.
 void expect_frame_within_2deg(const Case& c, int min_wall_px) {
   const View v = run_view(c.preset, c.index, c.seed);
-  const std::string name = std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
+  const std::string name =
+      std::string(c.preset) + " #" + std::to_string(c.index) + " seed " + std::to_string(c.seed);
   ASSERT_GE(v.truth.wall_or_riser_pixels, min_wall_px) << name;
   EXPECT_GE(v.yaw_err, 0.f) << name << ": no frame (" << v.sc.manhattan_why << ")";
   EXPECT_LE(v.yaw_err, 2.f) << name;
@@ -90,7 +91,8 @@ TEST(ManhattanFrame, PeopleMakeNoWrongFrame) {
 TEST(ManhattanFrame, PlanesParallelOnlyToDegreesMakeNoPair) {
   const View v = run_view("descending_static", 12, 6);
   ASSERT_TRUE(v.truth.any_stair_visible());
-  EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f) << "descending_static #12 seed 6: frame " << v.yaw_err << " deg off";
+  EXPECT_TRUE(v.yaw_err < 0.f || v.yaw_err <= 2.f)
+      << "descending_static #12 seed 6: frame " << v.yaw_err << " deg off";
 }
 
 // Narrow strips of one riser (0.13 and 0.15 m, 1.1 m apart on one line) and of one wall (0.13 and
@@ -125,8 +127,9 @@ TEST(ManhattanFrame, WideWallBeyondFurnitureGivesTheFrame) {
 // a staircase in view (seed 4 descending #14, seed 18 descending #6, seed 10 people #12). Its plane
 // held upright gives them within 2 deg.
 TEST(ManhattanFrame, WallAtTheDepthCutOffIsHeldUpright) {
-  const Case views[] = {{"descending_static", 14, 4}, {"descending_static", 6, 18}, {"floor_only_static", 9, 1},
-                        {"shelves_static", 6, 1},     {"people_static", 12, 10},    {"table_static", 14, 17}};
+  const Case views[] = {{"descending_static", 14, 4}, {"descending_static", 6, 18},
+                        {"floor_only_static", 9, 1},  {"shelves_static", 6, 1},
+                        {"people_static", 12, 10},    {"table_static", 14, 17}};
   for (const Case& c : views) expect_frame_within_2deg(c, 200);
 }
 
@@ -143,8 +146,10 @@ TEST(ManhattanFrame, NarrowWallOnTheFloorGivesTheFrame) {
 // up to a turn about that sloping axis, which turns its yaw. It made frames 4.4-5.5 deg off with
 // the staircase in view; it makes none now.
 TEST(ManhattanFrame, SlopedHandrailMakesNoFrame) {
-  const Case views[] = {{"descending_static", 16, 1}, {"descending_static", 7, 7}, {"descending_static", 20, 11},
-               {"people_static", 6, 9}};
+  const Case views[] = {{"descending_static", 16, 1},
+                        {"descending_static", 7, 7},
+                        {"descending_static", 20, 11},
+                        {"people_static", 6, 9}};
   for (const auto& c : views) {
     const View v = run_view(c.preset, c.index, c.seed);
     ASSERT_TRUE(v.truth.any_stair_visible()) << c.preset << " #" << c.index << " seed " << c.seed;
@@ -199,8 +204,8 @@ Pose level_camera() {
 /// at `c_f`, normal `n_f` (floor frame, towards the camera); points every `step` m, in camera
 /// coordinates, with what ManhattanTracker reads of a region.
 PlaneRegion rectangle(const Pose& T_floor_camera, const Eigen::Vector3f& c_f, const Eigen::Vector3f& n_f,
-                      const Eigen::Vector3f& along_f, const Eigen::Vector3f& across_f, float width, float height,
-                      float step) {
+                      const Eigen::Vector3f& along_f, const Eigen::Vector3f& across_f, float width,
+                      float height, float step) {
   PlaneRegion r;
   const Pose T_cf = T_floor_camera.inverse();
   for (float a = -0.5f * width; a <= 0.5f * width + 1e-4f; a += step)
@@ -225,8 +230,8 @@ PlaneRegion rectangle(const Pose& T_floor_camera, const Eigen::Vector3f& c_f, co
 PlaneRegion vertical_patch(const Pose& T_floor_camera, float yaw, float width) {
   const Eigen::Vector3f n_f(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
   const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
-  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 1.0f, 2.f), n_f, along_f, Eigen::Vector3f::UnitY(), width,
-                   0.3f, 0.02f);
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 1.0f, 2.f), n_f, along_f, Eigen::Vector3f::UnitY(),
+                   width, 0.3f, 0.02f);
 }
 
 /// A band `length` x 0.07 m along a level axis at `yaw` (rad), its plane tilted `tilt` (rad) from
@@ -236,8 +241,8 @@ PlaneRegion tilted_band(const Pose& T_floor_camera, float yaw, float tilt, float
   const Eigen::Vector3f n_h(-std::sin(yaw), 0.f, -std::cos(yaw));  // towards the camera
   const Eigen::Vector3f along_f(std::cos(yaw), 0.f, -std::sin(yaw));
   const Eigen::Vector3f n_f = std::cos(tilt) * n_h + std::sin(tilt) * Eigen::Vector3f::UnitY();
-  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 0.135f, 2.f), n_f, along_f, n_f.cross(along_f).normalized(),
-                   length, 0.07f, 0.01f);
+  return rectangle(T_floor_camera, Eigen::Vector3f(0.f, 0.135f, 2.f), n_f, along_f,
+                   n_f.cross(along_f).normalized(), length, 0.07f, 0.01f);
 }
 
 /// An upright rectangle `width` x `height` standing on the floor, its foot's centre `ahead` m in
@@ -295,9 +300,10 @@ TEST(ManhattanFrame, FarNarrowWallYieldsToNearerPlanesAgreeingWithIt) {
   const ManhattanConfig cfg;
   auto frame = [&](float riser_yaw, float wall_ahead, const ManhattanConfig& c) {
     ManhattanTracker m(c);
-    return m.estimate({floor_between(T, 0.8f, wall_ahead), upright_on_floor(T, wall_ahead, wall_yaw, 0.6f, 0.4f, 0.02f),
-                       upright_on_floor(T, 2.5f, riser_yaw, 1.5f, 0.17f, 0.02f)},
-                      T);
+    return m.estimate(
+        {floor_between(T, 0.8f, wall_ahead), upright_on_floor(T, wall_ahead, wall_yaw, 0.6f, 0.4f, 0.02f),
+         upright_on_floor(T, 2.5f, riser_yaw, 1.5f, 0.17f, 0.02f)},
+        T);
   };
   {
     const ManhattanEstimate e = frame(0.f, 4.6f, cfg);
@@ -622,17 +628,19 @@ TEST(ManhattanFrame, RiserCornerAtTheImageEdgeGivesTheFrame) {
 // seeds, all now within 0.61 deg). ascending_short #13 looks up a stairwell; nosing_landing #0
 // seed 10 at a flight's foot; people #15 seed 1 past people at the foot of one.
 TEST(ManhattanFrame, FloorRefusedStillGivesTheVertical) {
-  const Case views[] = {{"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 15, 1}};
+  const Case views[] = {
+      {"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 15, 1}};
   ManhattanConfig off;
   off.without_floor = false;
   for (const auto& c : views) {
     const View v = run_view(c.preset, c.index, c.seed);
     ASSERT_TRUE(v.truth.floor_visible) << c.preset << " #" << c.index << " seed " << c.seed;
     ASSERT_GE(v.truth.wall_or_riser_pixels, 200) << c.preset << " #" << c.index << " seed " << c.seed;
-    ASSERT_FALSE(v.sc.floor_found) << c.preset << " #" << c.index << " seed " << c.seed << ": the test does not test";
+    ASSERT_FALSE(v.sc.floor_found) << c.preset << " #" << c.index << " seed " << c.seed
+                                   << ": the test does not test";
     EXPECT_EQ(v.sc.floor_region, -1);
-    EXPECT_TRUE(v.sc.manhattan_without_floor) << c.preset << " #" << c.index << " seed " << c.seed << ": "
-                                              << v.sc.manhattan_why;
+    EXPECT_TRUE(v.sc.manhattan_without_floor)
+        << c.preset << " #" << c.index << " seed " << c.seed << ": " << v.sc.manhattan_why;
     EXPECT_GE(v.yaw_err, 0.f) << c.preset << " #" << c.index << " seed " << c.seed;
     EXPECT_LE(v.yaw_err, 2.f) << c.preset << " #" << c.index << " seed " << c.seed;
     const View w = run_view(c.preset, c.index, c.seed, off);
@@ -675,14 +683,16 @@ TEST(ManhattanFrame, WallReachingTheCutOffIsFittedClearOfIt) {
     const Eigen::Vector3f nu = fit_upright_normal(pts, up, n);
     const Eigen::Vector3f nc = fit_upright_normal_clear_of_cutoff(pts, up, nu, clear);
     refitted += !nc.isApprox(nu);
-    auto off_deg = [&](const Eigen::Vector3f& m) { return std::acos(std::min(1.f, m.dot(n))) * 180.0 / M_PI; };
+    auto off_deg = [&](const Eigen::Vector3f& m) {
+      return std::acos(std::min(1.f, m.dot(n))) * 180.0 / M_PI;
+    };
     err_upright += off_deg(nu);
     err_clear += off_deg(nc);
   }
   err_upright /= draws;
   err_clear /= draws;
-  std::printf("wall reaching the cut-off: mean yaw error %.2f deg held upright, %.2f fitted clear of it\n", err_upright,
-              err_clear);
+  std::printf("wall reaching the cut-off: mean yaw error %.2f deg held upright, %.2f fitted clear of it\n",
+              err_upright, err_clear);
   EXPECT_EQ(refitted, draws);
   // Measured: 0.92 deg held upright, 0.28 clear of the cut-off (the noise of the fewer readings).
   EXPECT_GT(err_upright, 0.7) << "the cut-off no longer biases the fit: the test does not test";
@@ -718,8 +728,11 @@ TEST(ManhattanFrame, FarWallsFittedClearOfTheCutOff) {
 // measured, frames off with a staircase in view went from 36 to 21 and right frames from 2628 to
 // 2639 of 2906.
 TEST(ManhattanFrame, FarNarrowWallsYieldWithRealLikeNoise) {
-  const Case views[] = {{"single_step_static", 4, 1}, {"single_step_static", 17, 3}, {"open_risers_static", 6, 6},
-                        {"single_step_static", 16, 10}, {"people_static", 9, 5}};
+  const Case views[] = {{"single_step_static", 4, 1},
+                        {"single_step_static", 17, 3},
+                        {"open_risers_static", 6, 6},
+                        {"single_step_static", 16, 10},
+                        {"people_static", 9, 5}};
   ManhattanConfig walls_first;
   walls_first.far_wall_agreement = 0.f;
   walls_first.riser_agreement = 0.f;  // the risers' rule (below) now catches most of these views too

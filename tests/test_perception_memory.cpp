@@ -38,8 +38,8 @@ TEST(PerceptionMemory, CameraHeightRememberedAtTheFootOfAStaircase) {
     worst = std::max(worst, err);
     within += err <= 0.03f;
   }
-  std::printf("frames without floor %d, with a remembered height %d, within 3 cm %d (worst %.3f m)\n", no_floor,
-              remembered, within, worst);
+  std::printf("frames without floor %d, with a remembered height %d, within 3 cm %d (worst %.3f m)\n",
+              no_floor, remembered, within, worst);
   ASSERT_GT(no_floor, 10) << "the walk should lose the floor at the first step";
   EXPECT_EQ(remembered, no_floor) << "a floor seen a few seconds ago is remembered";
   EXPECT_EQ(within, remembered) << "the remembered height is the wearer's";

@@ -25,9 +25,9 @@ constexpr float kCamHeight = 1.40f;
 Pose chest_camera(float tilt_deg) {
   const float t = tilt_deg * 3.14159265f / 180.f;
   Eigen::Matrix3f R;
-  R.col(0) = Eigen::Vector3f(1.f, 0.f, 0.f);                           // x right
-  R.col(2) = Eigen::Vector3f(0.f, std::cos(t), -std::sin(t));          // z forward, down
-  R.col(1) = R.col(2).cross(R.col(0));                                  // y down
+  R.col(0) = Eigen::Vector3f(1.f, 0.f, 0.f);                   // x right
+  R.col(2) = Eigen::Vector3f(0.f, std::cos(t), -std::sin(t));  // z forward, down
+  R.col(1) = R.col(2).cross(R.col(0));                         // y down
   Pose T = Pose::Identity();
   T.linear() = R;
   T.translation() = Eigen::Vector3f(0.f, 0.f, kCamHeight);
@@ -118,7 +118,8 @@ TEST(PerceptionRegions, GeometryAndClassesOnAKnownScene) {
   EXPECT_GT(P1.hull_extent, 0.85f) << "a rectangle fills its bounding rectangle";
   EXPECT_LT(P1.curvature, 0.01f);
   EXPECT_LT((T * P1.centroid - Eigen::Vector3f(0.f, 1.85f, 0.16f)).norm(), 0.03f);
-  EXPECT_GT((T.linear() * P1.rect_axis_major).cwiseAbs().x(), 0.98f) << "major axis along the platform's 1 m side";
+  EXPECT_GT((T.linear() * P1.rect_axis_major).cwiseAbs().x(), 0.98f)
+      << "major axis along the platform's 1 m side";
 
   // Its front face, facing the user: vertical front.
   const int front = find_region(sc, T, {0.f, 1.6f, 0.08f}, y, 0.1f);
@@ -251,9 +252,10 @@ TEST(PerceptionManhattan, KeepsItsBranchWhileTheUserTurns) {
     prev_world = world;
     have_prev = true;
   }
-  std::printf("turning walk: %d frames, Manhattan frame on %d; %d switches of axis; largest step otherwise %.1f deg, "
-              "world drift %.2f deg\n",
-              frames, found, switches, worst_step * 180.f / 3.14159265f, worst_world * 180.f / 3.14159265f);
+  std::printf(
+      "turning walk: %d frames, Manhattan frame on %d; %d switches of axis; largest step otherwise %.1f deg, "
+      "world drift %.2f deg\n",
+      frames, found, switches, worst_step * 180.f / 3.14159265f, worst_world * 180.f / 3.14159265f);
   EXPECT_GT(found, frames / 2);
   EXPECT_EQ(jumps, 0) << "k_M jumped to the other axis while the user still faced its own";
   // The walk turns across 45 degrees once (measured: one switch); without the hysteresis the

@@ -48,7 +48,8 @@ int find_tread(const SceneResult& sc, const StairTruth& st, int k, const Eigen::
     const PlaneRegion& R = sc.regions[r];
     if (std::fabs(R.normal.dot(up)) < std::cos(10 * kDeg)) continue;
     const Eigen::Vector3f c = T_sc * R.centroid;
-    if (std::fabs(c.y() - tread_y_stair(st, k)) > 0.05f || std::fabs(c.x()) > 0.5f * st.width_m + 0.1f) continue;
+    if (std::fabs(c.y() - tread_y_stair(st, k)) > 0.05f || std::fabs(c.x()) > 0.5f * st.width_m + 0.1f)
+      continue;
     if (best < 0 || R.pixel_count > sc.regions[best].pixel_count) best = r;
   }
   return best;

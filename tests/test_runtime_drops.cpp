@@ -56,11 +56,13 @@ WalkFigures run_walk(const std::string& input) {
 
 TEST(RuntimeDrops, PlatformWalkToldOnEveryNearFrame) {
   int near = 0, told = 0;
-  for (const char* input : {"synth:drop_platform_walk:460:911:real-v1", "synth:drop_platform_walk:460:912:tof-v2",
-                            "synth:drop_platform_walk:460:913:sl-v1"}) {
+  for (const char* input :
+       {"synth:drop_platform_walk:460:911:real-v1", "synth:drop_platform_walk:460:912:tof-v2",
+        "synth:drop_platform_walk:460:913:sl-v1"}) {
     const WalkFigures w = run_walk(input);
-    std::printf("%s: first told %.2f m before the edge; near %d/%d (mean |error| %.3f m); told out of view %d\n",
-                input, w.first_told_m, w.near_told, w.near, w.near_told ? w.abs_err / w.near_told : 0.0, w.far_told);
+    std::printf(
+        "%s: first told %.2f m before the edge; near %d/%d (mean |error| %.3f m); told out of view %d\n",
+        input, w.first_told_m, w.near_told, w.near, w.near_told ? w.abs_err / w.near_told : 0.0, w.far_told);
     EXPECT_GE(w.first_told_m, 1.9f) << input;
     EXPECT_GE(w.near, 100) << input;
     near += w.near;

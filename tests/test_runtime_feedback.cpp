@@ -87,7 +87,8 @@ TEST(RuntimeFeedback, WithoutPerceptionNothingIsSaid) {
 
 namespace {
 namespace fs = std::filesystem;
-const fs::path kPanDir = fs::path(STAIRGUIDE_BINARY_DIR) / ("runtime_feedback_files." + std::to_string(getpid()));
+const fs::path kPanDir =
+    fs::path(STAIRGUIDE_BINARY_DIR) / ("runtime_feedback_files." + std::to_string(getpid()));
 
 PipelineConfig to_file_pcm(const std::string& pcm) {
   PipelineConfig c;
@@ -129,7 +130,8 @@ TEST(RuntimeFeedback, StairsAheadArePlacedByTheirBearing) {
     const char* pcm;
     float bearing;
   };
-  for (const Case& c : {Case{"sg_rt_right", static_cast<float>(M_PI / 2)}, Case{"sg_rt_left", static_cast<float>(-M_PI / 2)}}) {
+  for (const Case& c : {Case{"sg_rt_right", static_cast<float>(M_PI / 2)},
+                        Case{"sg_rt_left", static_cast<float>(-M_PI / 2)}}) {
     {
       FeedbackStage stage(to_file_pcm(c.pcm));
       see_stairs(stage, 0.0, c.bearing, 30);
@@ -139,7 +141,8 @@ TEST(RuntimeFeedback, StairsAheadArePlacedByTheirBearing) {
     const auto h = sgtest::find_all(st.mid(), "stairs_up");
     ASSERT_EQ(h.size(), 1u) << c.pcm;
     const auto from = static_cast<std::size_t>(h[0].pos), to = from + clip.size();
-    const double db = 10.0 * std::log10(sgtest::energy(st.right, from, to) / sgtest::energy(st.left, from, to));
+    const double db =
+        10.0 * std::log10(sgtest::energy(st.right, from, to) / sgtest::energy(st.left, from, to));
     std::printf("%s: stairs ahead at %+.0f deg: right - left %+.1f dB\n", c.pcm, c.bearing * 57.29578, db);
     if (c.bearing > 0)
       EXPECT_GE(db, 6.0);
@@ -171,8 +174,9 @@ TEST(RuntimeFeedback, SlowWhenTheFramesAreDecidedLate) {
       p.seq = static_cast<std::uint64_t>(i);
       p.ran = p.floor_found = true;
       p.state = "floor";
-      const auto captured = std::chrono::steady_clock::now() -
-                            std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(lag));
+      const auto captured =
+          std::chrono::steady_clock::now() -
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(lag));
       const Decision d = stage.decide(p, nullptr, i / 30.0, captured);
       if (!d.cue.empty()) cues.push_back(d.cue);
     }

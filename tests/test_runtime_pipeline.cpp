@@ -43,8 +43,8 @@ class FloorSource : public FrameSource {
     long frames = 60;
     double fps = 30.0;
     bool live = false;
-    long error_at = -1;    ///< replay: kError at this frame
-    long timeout_at = -1;  ///< live: kTimeout from this frame on
+    long error_at = -1;                 ///< replay: kError at this frame
+    long timeout_at = -1;               ///< live: kTimeout from this frame on
     std::function<double(long)> ts;     ///< the frame's timestamp (empty: i / fps)
     std::function<void(long)> on_read;  ///< called before frame i is read
     long bad_alloc_at = -1;             ///< std::bad_alloc from read() at this frame
@@ -424,8 +424,8 @@ TEST(Runtime, ManhattanFrameIsCarriedByTheOdometryThroughAFastTurn) {
       seen += kv.at("manhattan") == "seen";
       carried += kv.at("manhattan") == "carried";
     }
-    std::printf("%s: Manhattan frame seen on %d frames, carried on %d\n", sync ? "one thread" : "threaded", seen,
-                carried);
+    std::printf("%s: Manhattan frame seen on %d frames, carried on %d\n", sync ? "one thread" : "threaded",
+                seen, carried);
     // Measured on one thread: seen on 5 frames, carried on 71 (the turn, and the glance away
     // before it; 7 and 69 when this test was written). Threaded, perception skips to the newest
     // frame, so how many of the few frames with a whole wall it works on depends on the machine's
@@ -580,7 +580,8 @@ TEST(Runtime, UntrustworthyTimestampsAreWarnedAndTheRunIsThatOfAGoodClock) {
   const Case cases[] = {
       {"jumps back 5 s", [](long i) { return i / 30.0 - (i >= 30 ? 5.0 : 0.0); }, 1,
        "frame 30 (#30 of the run): timestamp -4 goes back 4.967 s"},
-      {"equal", [](long) { return 12.5; }, 59, "frame 1 (#1 of the run): timestamp 12.5 equals the previous frame's"},
+      {"equal", [](long) { return 12.5; }, 59,
+       "frame 1 (#1 of the run): timestamp 12.5 equals the previous frame's"},
       {"reversed", [](long i) { return 100.0 - i / 30.0; }, 59, "frame 1 (#1 of the run): timestamp"},
       {"1e300", [](long i) { return i == 30 ? 1e300 : i / 30.0; }, 1,
        "frame 30 (#30 of the run): timestamp 1e+300 is not a time"},
@@ -630,7 +631,8 @@ TEST(Runtime, ALiveCameraWhoseClockJumpsBackKeepsAMonotoneTime) {
   EXPECT_EQ(rt.run(), 0);
   const auto l = lines.parse();
   ASSERT_EQ(l.size(), 30u);
-  for (std::size_t i = 1; i < l.size(); ++i) EXPECT_GT(std::stod(l[i].at("ts")), std::stod(l[i - 1].at("ts")));
+  for (std::size_t i = 1; i < l.size(); ++i)
+    EXPECT_GT(std::stod(l[i].at("ts")), std::stod(l[i - 1].at("ts")));
   EXPECT_EQ(rt.stats().timestamps_replaced, 1u);
   EXPECT_NE(log.text().find("frame 15 (#15 of the run): timestamp 400.5 goes back"), std::string::npos)
       << log.text();
@@ -642,7 +644,8 @@ TEST(Runtime, AThreadThatCannotStartIsNamedAndIsNotTheInput) {
   b.frames = 100000;
   RuntimeOptions o = replay_options(b, true, false, nullptr);
   o.start_thread = [](const char* name, std::function<void()> body) {
-    if (std::string(name) == "perception") throw std::system_error(EAGAIN, std::generic_category(), "pthread_create");
+    if (std::string(name) == "perception")
+      throw std::system_error(EAGAIN, std::generic_category(), "pthread_create");
     return std::thread(std::move(body));
   };
   Runtime rt(quiet_config(), o, nullptr);
@@ -652,9 +655,10 @@ TEST(Runtime, AThreadThatCannotStartIsNamedAndIsNotTheInput) {
   } catch (const SourceError& e) {
     FAIL() << "a thread that cannot start reads as the input's fault: " << e.what();
   } catch (const StartError& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot start the perception thread: pthread_create: Resource temporarily "
-                                         "unavailable"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("cannot start the perception thread: pthread_create: Resource temporarily "
+                                   "unavailable"),
+        std::string::npos)
         << e.what();
   }
   EXPECT_TRUE(rt.join(std::chrono::milliseconds(2000))) << "the threads already started stop";
@@ -702,10 +706,11 @@ TEST(Runtime, AnOdometryBehindTheCameraShowsInTheStatus) {
   ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(120)));
   ASSERT_TRUE(rt.join(std::chrono::seconds(2)));
   const RuntimeStats s = rt.stats();
-  std::printf("odometry %.2f ms a frame, its poses p50 %.1f ms p99 %.1f ms max %.1f ms after capture; "
-              "perception latency p50 %.1f ms\n",
-              s.odometry_ms_mean, s.odometry_lag_p50_ms, s.odometry_lag_p99_ms, s.odometry_lag_max_ms,
-              s.latency_p50_ms);
+  std::printf(
+      "odometry %.2f ms a frame, its poses p50 %.1f ms p99 %.1f ms max %.1f ms after capture; "
+      "perception latency p50 %.1f ms\n",
+      s.odometry_ms_mean, s.odometry_lag_p50_ms, s.odometry_lag_p99_ms, s.odometry_lag_max_ms,
+      s.latency_p50_ms);
   EXPECT_GT(s.odometry_lag_p50_ms, 5.0 * s.odometry_ms_mean) << "the ring's wait shows";
   // At most a ringful (32 frames) waits before the odometry: 1024 held 20 s of them.
   EXPECT_LT(s.odometry_lag_max_ms, 60.0 * std::max(1.0, s.odometry_ms_mean) + 1000.0);

@@ -34,7 +34,8 @@ struct Errors {
 };
 
 Errors errors(const StairResult& r, const StairTruth& t) {
-  return {std::fabs(r.riser_m - t.riser_m), std::fabs(r.tread_m - t.tread_m), std::fabs(r.width_m - t.width_m),
+  return {std::fabs(r.riser_m - t.riser_m), std::fabs(r.tread_m - t.tread_m),
+          std::fabs(r.width_m - t.width_m),
           (r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm(),
           yaw_error_deg(r.T_camera_stair, t.T_camera_stair)};
 }
@@ -161,10 +162,9 @@ TEST(StairsUnit, BuildingCodesDescribeRisersAndNeverSilenceThem) {
   // (config/profiles/paper.yaml): both are told, and described as steep.
   const PipelineConfig paper =
       load_config(std::string(STAIRGUIDE_SOURCE_DIR) + "/config/profiles/paper.yaml");
-  for (const auto& [riser, config, over_code] :
-       {std::tuple<float, PipelineConfig, bool>{0.235f, cfg(), true},
-        {0.195f, paper, true},
-        {0.195f, cfg(), false}}) {
+  for (const auto& [riser, config, over_code] : {std::tuple<float, PipelineConfig, bool>{0.235f, cfg(), true},
+                                                 {0.195f, paper, true},
+                                                 {0.195f, cfg(), false}}) {
     SceneBuilder b(1.4f, 45.f, 2);
     StairSpec s;
     s.riser = riser;
@@ -173,9 +173,11 @@ TEST(StairsUnit, BuildingCodesDescribeRisersAndNeverSilenceThem) {
     StairStage stage(config);
     StairResult r;
     stage.run(b.scene, r);
-    ASSERT_TRUE(r.detected) << riser << ": " << to_string(r.verdict) << ", " << r.levels << " levels, riser " << r.riser_m;
+    ASSERT_TRUE(r.detected) << riser << ": " << to_string(r.verdict) << ", " << r.levels << " levels, riser "
+                            << r.riser_m;
     EXPECT_NEAR(r.riser_m, riser, 0.01f);
-    EXPECT_EQ((r.code_notes & kCodeHighRisers) != 0, over_code) << riser << ": " << code_notes_text(r.code_notes);
+    EXPECT_EQ((r.code_notes & kCodeHighRisers) != 0, over_code)
+        << riser << ": " << code_notes_text(r.code_notes);
   }
 }
 
@@ -531,7 +533,8 @@ TEST(StairsUnit, HiddenFirstStepsNeedAWholeNumberOfRisersAndTheViewBottom) {
     b.scene.floor_tracked = true;
     int first = -1;
     for (std::size_t i = 0; i < b.scene.regions.size(); ++i)
-      if (b.scene.regions[i].cls == RegionClass::kStepCandidate && std::fabs(b.scene.regions[i].height + 0.17f) < 0.02f)
+      if (b.scene.regions[i].cls == RegionClass::kStepCandidate &&
+          std::fabs(b.scene.regions[i].height + 0.17f) < 0.02f)
         first = static_cast<int>(i);
     ASSERT_GE(first, 0);
     b.scene.regions[static_cast<std::size_t>(first)].cls = RegionClass::kObstacle;
@@ -635,7 +638,6 @@ TEST(StairsUnit, AccuracyOverManyRandomStaircases) {
   EXPECT_LT(yaw / detected, 1.0);
 }
 
-
 // ---- evaluation: which way a curb goes, and the kind as the user needs it ----
 
 /// A frame whose one stair (kind, direction) has its first edge 1.5 m ahead, one tread in view.
@@ -652,8 +654,9 @@ FrameTruth one_level_truth(StairKind kind, bool down) {
   s.width_m = 1.2f;
   s.T_camera_stair = Pose::Identity();
   s.T_camera_stair.translation() = Eigen::Vector3f(0.f, 1.2f, 1.5f);
-  s.visible_steps = kind == StairKind::kAscending || kind == StairKind::kDescending ? std::vector<int>{1, 2, 3}
-                                                                                     : std::vector<int>{1};
+  s.visible_steps = kind == StairKind::kAscending || kind == StairKind::kDescending
+                        ? std::vector<int>{1, 2, 3}
+                        : std::vector<int>{1};
   s.visible_pixels.assign(s.visible_steps.size(), 1000);
   s.first_edge_visible = s.both_ends_visible = true;
   f.stairs.push_back(s);
@@ -695,7 +698,8 @@ TEST(StairsEval, CurbInTheWrongDirectionIsWrong) {
   EXPECT_STREQ(wrong.truth_label(), "curb_down");
   EXPECT_STREQ(wrong.predicted_label(), "curb_up");
   // ... and as a single step (up): the same.
-  EXPECT_TRUE(evaluate_stair_frame(one_level_result(down, StairKind::kSingleStep, 0.15f), down).wrong_direction);
+  EXPECT_TRUE(
+      evaluate_stair_frame(one_level_result(down, StairKind::kSingleStep, 0.15f), down).wrong_direction);
   // The right way: a TP of exactly the right kind.
   const StairFrameEval right = evaluate_stair_frame(one_level_result(down, StairKind::kCurb, -0.15f), down);
   EXPECT_EQ(right.outcome, EvalOutcome::kTP);
@@ -741,8 +745,9 @@ TEST(StairsEval, SingleStepAsCurbUpIsRightForTheUserButNotExact) {
   EXPECT_EQ(table.all.confusion.at("single_step").at("curb_up"), 1);
   EXPECT_EQ(table.all.confusion.at("descending").at("curb_down"), 1);
   const std::string json = table.to_json();
-  EXPECT_NE(json.find("\"confusion\": {\"descending\": {\"curb_down\": 1}, \"single_step\": {\"curb_up\": 1}}"),
-            std::string::npos)
+  EXPECT_NE(
+      json.find("\"confusion\": {\"descending\": {\"curb_down\": 1}, \"single_step\": {\"curb_up\": 1}}"),
+      std::string::npos)
       << json;
   EXPECT_NE(table.to_text().find("kind confusion"), std::string::npos);
 }
@@ -752,9 +757,7 @@ TEST(StairsEval, LabelsCarryTheCurbDirection) {
   const std::string dir = std::string(STAIRGUIDE_BINARY_DIR) + "/test_stairs_labels";
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/labels.yaml";
-  auto write = [&](const std::string& text) {
-    std::ofstream(path) << text;
-  };
+  auto write = [&](const std::string& text) { std::ofstream(path) << text; };
   write(labels_to_yaml({f}));
   const auto back = read_labels_yaml(path);
   ASSERT_EQ(back.size(), 1u);

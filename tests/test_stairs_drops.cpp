@@ -76,11 +76,13 @@ TEST(DropPresets, TruthInRange) {
 
 // Told on the views with the edge within 2 m, where it is (distance within 5 cm on average).
 TEST(DropDetection, ToldOnTheDropPresets) {
-  for (const char* preset : {"drop_platform_static", "drop_dock_static", "drop_hole_static", "drop_sunken_static"})
+  for (const char* preset :
+       {"drop_platform_static", "drop_dock_static", "drop_hole_static", "drop_sunken_static"})
     for (const char* noise : {"real-v1", "tof-v2"}) {
       const DropRun r = run_preset(preset, 16, 31, noise);
-      std::printf("%-22s %-8s near %d/%d (%d missed with no floor found), mean |distance error| %.3f m\n", preset,
-                  noise, r.near_told, r.near, r.near_no_floor, r.near_told ? r.abs_distance_err / r.near_told : 0.0);
+      std::printf("%-22s %-8s near %d/%d (%d missed with no floor found), mean |distance error| %.3f m\n",
+                  preset, noise, r.near_told, r.near, r.near_no_floor,
+                  r.near_told ? r.abs_distance_err / r.near_told : 0.0);
       ASSERT_GE(r.near, 3) << preset;
       // Every view with its floor found is told; a view whose floor is a strip at the bottom of the
       // image (the edge 0.5-0.7 m away) may have no floor from perception, and then no drop.
@@ -95,10 +97,10 @@ TEST(DropDetection, ToldOnTheDropPresets) {
 // Silent on rooms, corridors and furniture of both worlds, with every sensor model's artefacts
 // (dark floors that read nothing beyond 2 m included).
 TEST(DropDetection, SilentOnStairFreePresets) {
-  const std::vector<std::string> presets = {"floor_only_static",  "corridor_static",       "room_clutter_static",
-                                            "table_static",       "low_platform_static",   "rig_furniture_static",
-                                            "world2_bed_static",  "world2_lowtable_static", "world2_boxes_static",
-                                            "world2_sofa_static", "world2_shelves_static", "world2_bench_static"};
+  const std::vector<std::string> presets = {
+      "floor_only_static",   "corridor_static",      "room_clutter_static",   "table_static",
+      "low_platform_static", "rig_furniture_static", "world2_bed_static",     "world2_lowtable_static",
+      "world2_boxes_static", "world2_sofa_static",   "world2_shelves_static", "world2_bench_static"};
   for (const auto& p : presets)
     for (const char* noise : {"real-v1", "real-v2", "sl-v1"}) {
       const DropRun r = run_preset(p, 6, 41, noise);
@@ -121,7 +123,8 @@ TEST(DropDetection, DescentSeenByTheStairStageIsNotADrop) {
     }
   }
   EXPECT_GE(descents, 8);
-  std::printf("descending_static: %d descents told by the stair stage, %d of them also a drop edge\n", descents, both);
+  std::printf("descending_static: %d descents told by the stair stage, %d of them also a drop edge\n",
+              descents, both);
 }
 
 // What the stage says when it cannot look: no floor, disabled; and every length in the result

@@ -58,14 +58,17 @@ TEST(StairsEdge, LeanOnlyAtTheEdge) {
     // Ascending: tread 1 under the camera, tread 2 seen first. Descending: the floor's edge and
     // tread 1 under the camera's vertical.
     const int hidden = dir > 0 ? 1 : 0;
-    const StairResult r = lean_view(stage, dir, -0.05f, 0.06f, hidden, 71u + static_cast<unsigned>(dir + 1), t);
+    const StairResult r =
+        lean_view(stage, dir, -0.05f, 0.06f, hidden, 71u + static_cast<unsigned>(dir + 1), t);
     ASSERT_TRUE(r.detected) << "dir " << dir << ": " << to_string(r.verdict);
     EXPECT_TRUE(r.floor_remembered);
     EXPECT_EQ(r.direction(), dir);
     EXPECT_NEAR(stage.floorless_trace().lean, 0.06f, 0.015f) << "dir " << dir;
-    EXPECT_LT((r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm(), 0.03f) << "dir " << dir;
+    EXPECT_LT((r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm(), 0.03f)
+        << "dir " << dir;
     ASSERT_GT(r.level_data.size(), 1u);
-    EXPECT_NEAR(std::fabs(r.level_data[1].height), static_cast<float>(std::abs(r.level_data[1].index)) * 0.17f, 0.02f);
+    EXPECT_NEAR(std::fabs(r.level_data[1].height),
+                static_cast<float>(std::abs(r.level_data[1].index)) * 0.17f, 0.02f);
     EXPECT_EQ(std::abs(r.level_data[1].index), 1 + hidden);
     std::printf("dir %+d: lean %.3f m, first edge %.3f m ahead, origin error %.2f cm\n", dir,
                 stage.floorless_trace().lean, stage.floorless_trace().lean_edge_ahead,
@@ -91,8 +94,8 @@ struct EdgeFigures {
 /// Runs `walk` (seed `seed`) through perception from its first frame to `end`, every `stride`-th
 /// frame before `from` (perception tracks the floor and verifies the camera height on those) and
 /// every frame after, and scores the frames from `from` on with the user still on the floor before
-/// the flight (truth user_step 0) and the flight expected. Every frame from `from` on, on the flight or not, must not go the wrong
-/// way or off the flight.
+/// the flight (truth user_step 0) and the flight expected. Every frame from `from` on, on the flight or not,
+/// must not go the wrong way or off the flight.
 EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, long end) {
   sgtest::SynthStairs p;
   const SceneResult& scene = p.scene;
@@ -108,8 +111,9 @@ EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, lo
     if (e.outcome != EvalOutcome::kTP && e.outcome != EvalOutcome::kFN) continue;
     ++f.scored;
     if (e.outcome != EvalOutcome::kTP) {
-      std::printf("%s seed %u frame %ld: %s (%s, floor %s, remembered %.3f m)\n", walk, seed, i, to_string(e.outcome),
-                  to_string(r.verdict), scene.floor_found ? "found" : "not found", scene.remembered_camera_height);
+      std::printf("%s seed %u frame %ld: %s (%s, floor %s, remembered %.3f m)\n", walk, seed, i,
+                  to_string(e.outcome), to_string(r.verdict), scene.floor_found ? "found" : "not found",
+                  scene.remembered_camera_height);
       continue;
     }
     ++f.tp;
@@ -117,20 +121,23 @@ EdgeFigures run_edge(const char* walk, unsigned seed, long stride, long from, lo
     const StairTruth& t = truth.stairs[0];
     // The first edge (origin of S: the floor's edge descending, the first nosing ascending), where
     // it lies even out of view; riser, tread, and the first seen level's step number.
-    f.worst_origin = std::max(f.worst_origin, (r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm());
+    f.worst_origin =
+        std::max(f.worst_origin, (r.T_camera_stair.translation() - t.T_camera_stair.translation()).norm());
     f.worst_riser = std::max(f.worst_riser, std::fabs(r.riser_m - t.riser_m));
     f.worst_tread = std::max(f.worst_tread, std::fabs(r.tread_m - t.tread_m));
     // The nearest seen level's step number (steps before it out of view) must agree with its
     // height: k risers from the floor the user stands on.
     if (r.level_data.size() > 1) {
       const StairLevel& l = r.level_data[1];
-      if (std::fabs(std::fabs(l.height) - static_cast<float>(std::abs(l.index)) * t.riser_m) > 0.03f) ++f.wrong_index;
+      if (std::fabs(std::fabs(l.height) - static_cast<float>(std::abs(l.index)) * t.riser_m) > 0.03f)
+        ++f.wrong_index;
     }
   }
-  std::printf("%s seed %u frames %ld-%ld: %d on the floor at the edge, %d found (%d by the lean), first edge "
-              "within %.2f cm, riser %.2f cm, tread %.2f cm; %d wrong step number, %d wrong way, %d off the flight\n",
-              walk, seed, from, end, f.scored, f.tp, f.lean, 100.f * f.worst_origin, 100.f * f.worst_riser,
-              100.f * f.worst_tread, f.wrong_index, f.wrong_direction, f.false_positive);
+  std::printf(
+      "%s seed %u frames %ld-%ld: %d on the floor at the edge, %d found (%d by the lean), first edge "
+      "within %.2f cm, riser %.2f cm, tread %.2f cm; %d wrong step number, %d wrong way, %d off the flight\n",
+      walk, seed, from, end, f.scored, f.tp, f.lean, 100.f * f.worst_origin, 100.f * f.worst_riser,
+      100.f * f.worst_tread, f.wrong_index, f.wrong_direction, f.false_positive);
   return f;
 }
 

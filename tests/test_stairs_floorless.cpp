@@ -80,9 +80,11 @@ struct Tally {
     }
   }
   void print(const char* what) const {
-    std::printf("%-34s frames %3d detected %3d wrong direction %d; riser |err| mean %.2f max %.2f cm; tread (%d) |err| mean %.2f max %.2f cm\n",
-                what, frames, detected, wrong_direction, detected ? 100.0 * riser_abs / detected : 0.0, 100.0 * riser_max,
-                with_tread, with_tread ? 100.0 * tread_abs / with_tread : 0.0, 100.0 * tread_max);
+    std::printf(
+        "%-34s frames %3d detected %3d wrong direction %d; riser |err| mean %.2f max %.2f cm; tread (%d) "
+        "|err| mean %.2f max %.2f cm\n",
+        what, frames, detected, wrong_direction, detected ? 100.0 * riser_abs / detected : 0.0,
+        100.0 * riser_max, with_tread, with_tread ? 100.0 * tread_abs / with_tread : 0.0, 100.0 * tread_max);
   }
 };
 
@@ -112,9 +114,10 @@ TEST(StairsFloorless, StaircasesWithoutFloor) {
           stage.run(b.scene, r);
           (dir > 0 ? asc : desc).add(r, s);
           if (!r.detected)
-            std::printf("miss: dir %d tilt %.0f yaw %.0f dist %.1f: %s (levels %d, stacked %d, direction %d)\n", dir, tilt, yaw,
-                        dist, to_string(r.verdict), r.levels, stage.floorless_trace().stacked,
-                        stage.floorless_trace().direction);
+            std::printf(
+                "miss: dir %d tilt %.0f yaw %.0f dist %.1f: %s (levels %d, stacked %d, direction %d)\n", dir,
+                tilt, yaw, dist, to_string(r.verdict), r.levels, stage.floorless_trace().stacked,
+                stage.floorless_trace().direction);
           if (dir > 0) {
             // The first tread out of view too: the stack starts at tread 2.
             SceneBuilder c(1.4f, tilt, seed++);
@@ -156,8 +159,8 @@ TEST(StairsFloorless, OriginOnTheFirstSeenEdge) {
   ASSERT_TRUE(r.detected) << to_string(r.verdict);
   EXPECT_EQ(r.kind, StairKind::kAscending);
   const float pos = (r.T_camera_stair.translation() - b.truth.T_camera_stair.translation()).norm();
-  const float yaw = rad2deg(std::acos(std::clamp(
-      r.T_camera_stair.linear().col(2).dot(b.truth.T_camera_stair.linear().col(2)), -1.f, 1.f)));
+  const float yaw = rad2deg(std::acos(
+      std::clamp(r.T_camera_stair.linear().col(2).dot(b.truth.T_camera_stair.linear().col(2)), -1.f, 1.f)));
   std::printf("origin error %.2f cm, yaw error %.2f deg, levels %d\n", 100.f * pos, yaw, r.levels);
   EXPECT_LT(pos, 0.03f);
   EXPECT_LT(yaw, 2.f);
@@ -172,7 +175,9 @@ TEST(StairsFloorless, FurnitureIsNoStaircase) {
   StairResult r;
   {  // shelves: boards one riser apart straight above each other (no tread)
     SceneBuilder b(1.4f, 45.f, 11);
-    for (int k = 0; k < 4; ++k) b.add_box_top(0.f, 1.6f, 1.0f, 0.35f, 0.3f + 0.17f * static_cast<float>(k), RegionClass::kStepCandidate);
+    for (int k = 0; k < 4; ++k)
+      b.add_box_top(0.f, 1.6f, 1.0f, 0.35f, 0.3f + 0.17f * static_cast<float>(k),
+                    RegionClass::kStepCandidate);
     b.scene.floor_found = false;
     stage.run(b.scene, r);
     EXPECT_FALSE(r.detected) << to_string(r.verdict);
@@ -268,7 +273,8 @@ TEST(StairsFloorless, RememberedFloorPlacesTheFirstStep) {
           worst = std::max(worst, origin_error(r, b.truth));
           placed += origin_error(r, b.truth) < 0.03f;
         } else {
-          ADD_FAILURE() << "dir " << dir << " tilt " << tilt << " yaw " << yaw << ": " << to_string(r.verdict);
+          ADD_FAILURE() << "dir " << dir << " tilt " << tilt << " yaw " << yaw << ": "
+                        << to_string(r.verdict);
         }
         // (b) the floor seen as a level (the floor detector refused it): it is level 0.
         SceneBuilder c(kHeight, tilt, seed++);
@@ -276,7 +282,9 @@ TEST(StairsFloorless, RememberedFloorPlacesTheFirstStep) {
         c.scene.floor_found = false;
         c.scene.remembered_camera_height = kHeight;
         stage.run(c.scene, r);
-        if (r.detected && r.floor_remembered && origin_error(r, c.truth) < 0.03f && r.level_data[1].index == dir) ++floor_placed;
+        if (r.detected && r.floor_remembered && origin_error(r, c.truth) < 0.03f &&
+            r.level_data[1].index == dir)
+          ++floor_placed;
         if (dir < 0) continue;
         // (c) tread 1 out of view too (under the camera): placed one tread before tread 2.
         SceneBuilder d(kHeight, tilt, seed++);
@@ -285,15 +293,17 @@ TEST(StairsFloorless, RememberedFloorPlacesTheFirstStep) {
         drop_first_treads(d.scene, 1);
         d.scene.remembered_camera_height = kHeight;
         stage.run(d.scene, r);
-        if (r.detected && r.floor_remembered && origin_error(r, d.truth) < 0.03f && r.level_data[1].index == 2 &&
-            std::fabs(r.level_data[1].height - 2.f * s.riser) < 0.01f)
+        if (r.detected && r.floor_remembered && origin_error(r, d.truth) < 0.03f &&
+            r.level_data[1].index == 2 && std::fabs(r.level_data[1].height - 2.f * s.riser) < 0.01f)
           ++hidden_placed;
       }
     }
   }
-  std::printf("remembered floor: first edge within 3 cm in %d of %d views (worst %.2f cm); floor seen as a level %d of "
-              "%d; tread 1 hidden %d of %d\n",
-              placed, views, 100.f * worst, floor_placed, views, hidden_placed, views / 2);
+  std::printf(
+      "remembered floor: first edge within 3 cm in %d of %d views (worst %.2f cm); floor seen as a level %d "
+      "of "
+      "%d; tread 1 hidden %d of %d\n",
+      placed, views, 100.f * worst, floor_placed, views, hidden_placed, views / 2);
   EXPECT_EQ(placed, views);
   EXPECT_EQ(floor_placed, views);
   EXPECT_EQ(hidden_placed, views / 2);
@@ -357,9 +367,10 @@ TEST(StairsFloorless, ArrivalAtTheFootOfAClimb) {
                   to_string(e.outcome), to_string(r.verdict), r.levels, p.stage.floorless_trace().first_index,
                   p.stage.floorless_trace().first_offset);
   }
-  std::printf("arrival without floor: %d frames, %d expected, %d found (%d from the remembered floor), %d off the "
-              "edge, %d wrong direction\n",
-              floorless, expected, tp, remembered, off_edge, wrong_direction);
+  std::printf(
+      "arrival without floor: %d frames, %d expected, %d found (%d from the remembered floor), %d off the "
+      "edge, %d wrong direction\n",
+      floorless, expected, tp, remembered, off_edge, wrong_direction);
   ASSERT_GE(floorless, 60) << "the walk should lose the floor before the first step";
   EXPECT_EQ(off_edge, 0) << "a staircase placed off its first edge";
   EXPECT_EQ(wrong_direction, 0);
@@ -373,7 +384,9 @@ TEST(StairsFloorless, ArrivalAtTheFootOfAClimb) {
 // it is the floor, and the staircase is placed from it. Over every view of the two approach walks
 // taken cold, nothing may be placed off its true first edge or the wrong way (a first tread cut
 // by the border is no deeper than a tread, so it is never taken for the floor).
-bool result_direction_ok(const StairResult& r, const StairTruth& t) { return (r.direction() < 0) == t.goes_down(); }
+bool result_direction_ok(const StairResult& r, const StairTruth& t) {
+  return (r.direction() < 0) == t.goes_down();
+}
 
 /// Distance, m, from a result's origin to the nearest true step edge line of `t` (edge 1 is the
 /// truth's origin; edge k lies k - 1 treads on and k - 1 risers up, or down descending), and that
@@ -385,7 +398,8 @@ float nearest_edge(const StairResult& r, const StairTruth& t, int& k) {
   k = 0;
   for (int e = 1; e <= std::max(1, t.steps); ++e) {
     const Eigen::Vector3f edge =
-        t.T_camera_stair * Eigen::Vector3f(0.f, up * static_cast<float>(e - 1) * t.riser_m, static_cast<float>(e - 1) * t.tread_m);
+        t.T_camera_stair * Eigen::Vector3f(0.f, up * static_cast<float>(e - 1) * t.riser_m,
+                                           static_cast<float>(e - 1) * t.tread_m);
     const Eigen::Vector3f d = o - edge;
     const float dist = (d - x * x.dot(d)).norm();
     if (dist < best) {
@@ -455,14 +469,16 @@ TEST(StairsFloorless, ColdViewsNearTheFirstEdge) {
       }
       if (!ok) {
         ++off_edge;
-        std::printf("%s %ld: %s, nearest true edge %d at %.2f m (levels %d, distance %s)\n", walk, i, to_string(e.outcome), k, d,
-                    r.levels, r.without_floor ? "unknown" : "known");
+        std::printf("%s %ld: %s, nearest true edge %d at %.2f m (levels %d, distance %s)\n", walk, i,
+                    to_string(e.outcome), k, d, r.levels, r.without_floor ? "unknown" : "known");
       }
     }
   }
-  std::printf("cold views without floor: %d; placed from the feet %d (%d from a floor level seen), first step unknown %d; "
-              "off every true edge %d, wrong direction %d\n",
-              cold, placed, placed_from_floor, unplaced, off_edge, wrong_direction);
+  std::printf(
+      "cold views without floor: %d; placed from the feet %d (%d from a floor level seen), first step "
+      "unknown %d; "
+      "off every true edge %d, wrong direction %d\n",
+      cold, placed, placed_from_floor, unplaced, off_edge, wrong_direction);
   ASSERT_GE(cold, 10) << "the walks should lose the floor near the first edge";
   EXPECT_EQ(off_edge, 0) << "a staircase placed off its edges";
   EXPECT_EQ(wrong_direction, 0);

@@ -85,7 +85,8 @@ TEST(StairsHeldout, StepStripsStaySteps) {
         wrong_way += e.wrong_direction ? 1 : 0;
       }
     }
-    std::printf("%-20s seeds 1-12, even views: TP %d FP %d wrong direction %d\n", p.preset, tp, fp, wrong_way);
+    std::printf("%-20s seeds 1-12, even views: TP %d FP %d wrong direction %d\n", p.preset, tp, fp,
+                wrong_way);
     EXPECT_EQ(fp, 0) << p.preset;
     EXPECT_EQ(wrong_way, 0) << p.preset;
     EXPECT_GE(tp, p.min_tp) << p.preset;
@@ -153,7 +154,10 @@ TEST(StairsHeldout, FloorAroundTheStairwellIsNoStep) {
     std::uint32_t seed;
     long view;
     int steps;  // treads seen (the truth's visible steps): 9, 11, 6 and 7 levels were stacked
-  } views[] = {{"descending_static", 9, 12, 8}, {"descending_static", 3, 8, 10}, {"people_static", 2, 20, 5}, {"people_static", 7, 18, 6}};
+  } views[] = {{"descending_static", 9, 12, 8},
+               {"descending_static", 3, 8, 10},
+               {"people_static", 2, 20, 5},
+               {"people_static", 7, 18, 6}};
   for (const auto& v : views) {
     sgtest::SynthStairs p;
     const StairResult& r = p.step(v.preset, v.view, v.seed, /*cold=*/true);

@@ -39,7 +39,9 @@ StairHypothesis levels_of(const SceneResult& scene, int direction) {
 }
 
 // The floor's up in the camera frame, as the scene's transform gives it.
-Eigen::Vector3f floor_up(const SceneResult& scene) { return scene.T_floor_camera.linear().row(1).transpose(); }
+Eigen::Vector3f floor_up(const SceneResult& scene) {
+  return scene.T_floor_camera.linear().row(1).transpose();
+}
 
 float angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
   return rad2deg(std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.f, 1.f)));

@@ -27,9 +27,12 @@ std::vector<std::vector<std::string>> read_labels(const std::string& path) {
     std::vector<std::string> f(1);
     bool q = false;
     for (char c : line) {
-      if (c == '"') q = !q;
-      else if (c == ',' && !q) f.emplace_back();
-      else f.back() += c;
+      if (c == '"')
+        q = !q;
+      else if (c == ',' && !q)
+        f.emplace_back();
+      else
+        f.back() += c;
     }
     if (f.size() >= 2) rows.push_back(f);
   }
@@ -64,13 +67,15 @@ TEST(StairsReal, LabelledFrames) {
     StairResult r;
     stage.run(scene, frame.intrinsics, r);
     const FloorlessTrace& t = stage.floorless_trace();
-    std::printf("%-72s %-6s -> %-10s %s (%s) levels %d riser %.1f cm tread %.1f cm width %.2f m\n", row[0].c_str(),
-                row[1].c_str(), r.detected ? to_string(r.kind) : "none", scene.floor_found ? "floor" : "no floor",
-                to_string(r.verdict), r.levels, 100.f * r.riser_m, 100.f * r.tread_m, r.width_m);
+    std::printf("%-72s %-6s -> %-10s %s (%s) levels %d riser %.1f cm tread %.1f cm width %.2f m\n",
+                row[0].c_str(), row[1].c_str(), r.detected ? to_string(r.kind) : "none",
+                scene.floor_found ? "floor" : "no floor", to_string(r.verdict), r.levels, 100.f * r.riser_m,
+                100.f * r.tread_m, r.width_m);
     if (!scene.floor_found) {
-      std::printf("    floorless: up %d tilt %.1f roll %.1f family %d levels %d stacked %d dir %d edges %d heights",
-                  t.up_found, rad2deg(t.tilt), rad2deg(t.roll), t.family_regions, t.levels, t.stacked, t.direction,
-                  t.edges_seen);
+      std::printf(
+          "    floorless: up %d tilt %.1f roll %.1f family %d levels %d stacked %d dir %d edges %d heights",
+          t.up_found, rad2deg(t.tilt), rad2deg(t.roll), t.family_regions, t.levels, t.stacked, t.direction,
+          t.edges_seen);
       for (float h : t.level_heights) std::printf(" %.3f", h);
       std::printf("\n");
     }
@@ -94,11 +99,14 @@ TEST(StairsReal, LabelledFrames) {
         skh += k * h;
       }
       const double riser_planes = std::fabs((n * skh - sk * sh) / (n * skk - sk * sk));
-      std::printf("    riser from plane offsets %.1f cm, model %.1f cm\n", 100.0 * riser_planes, 100.0 * r.riser_m);
+      std::printf("    riser from plane offsets %.1f cm, model %.1f cm\n", 100.0 * riser_planes,
+                  100.0 * r.riser_m);
       EXPECT_NEAR(r.riser_m, riser_planes, 0.015) << row[0];
     }
-    if (row[0].rfind("stair-perception-fhg/", 0) == 0 && r.detected && r.kind == StairKind::kAscending) ++fhg_detected;
-    if (row[0].find("capture000") != std::string::npos && t.stacked >= 2 && t.direction > 0) ++capture_stacked_up;
+    if (row[0].rfind("stair-perception-fhg/", 0) == 0 && r.detected && r.kind == StairKind::kAscending)
+      ++fhg_detected;
+    if (row[0].find("capture000") != std::string::npos && t.stacked >= 2 && t.direction > 0)
+      ++capture_stacked_up;
     if (row[1] == "none") {
       ++none_frames;
       none_detected += r.detected;
@@ -109,8 +117,8 @@ TEST(StairsReal, LabelledFrames) {
       if (r.detected && (r.kind == StairKind::kDescending || r.kind == StairKind::kCurb)) ++wrong_direction;
     }
   }
-  std::printf("real frames: 'none' %d of %d detected; 'stair' %d of %d detected\n", none_detected, none_frames,
-              stair_detected, stair_frames);
+  std::printf("real frames: 'none' %d of %d detected; 'stair' %d of %d detected\n", none_detected,
+              none_frames, stair_detected, stair_frames);
   // Every stair-free frame labels.csv lists (12 since the boxes and the floor with a chair came),
   // each read and each silent: the count follows the file, and may only grow.
   EXPECT_GE(none_frames, 12);

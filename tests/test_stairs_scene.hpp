@@ -18,12 +18,12 @@ using stairguide::RegionClass;
 using stairguide::SceneResult;
 
 struct StairSpec {
-  int direction = 1;       // +1 ascending, -1 descending
+  int direction = 1;  // +1 ascending, -1 descending
   int steps = 6;
   float riser = 0.17f, tread = 0.29f, width = 1.2f;
-  float distance = 1.5f;   // m from the camera's foot to the first edge, along the camera's forward
-  float lateral = 0.f;     // m, sideways offset of the first edge's centre (to the left)
-  float yaw_deg = 10.f;    // stair direction against the camera's forward
+  float distance = 1.5f;  // m from the camera's foot to the first edge, along the camera's forward
+  float lateral = 0.f;    // m, sideways offset of the first edge's centre (to the left)
+  float yaw_deg = 10.f;   // stair direction against the camera's forward
 };
 
 class SceneBuilder {
@@ -75,16 +75,19 @@ class SceneBuilder {
     const Eigen::Vector3f cam_s = T_cs.inverse().translation();
     const float base = s.direction > 0 ? -s.riser : 0.f;  // floor height in S
     // Floor: in front of the first edge, wider than the staircase.
-    add_patch(T_cs, -1.5f - s.width / 2, 1.5f + s.width / 2, -floor_depth, 0.f, base, RegionClass::kFloor, cam_s, {});
+    add_patch(T_cs, -1.5f - s.width / 2, 1.5f + s.width / 2, -floor_depth, 0.f, base, RegionClass::kFloor,
+              cam_s, {});
     scene.floor_region = static_cast<int>(scene.regions.size()) - 1;
     for (int k = 1; k <= s.steps; ++k) {
-      const float y = s.direction > 0 ? static_cast<float>(k - 1) * s.riser : -static_cast<float>(k) * s.riser;
+      const float y =
+          s.direction > 0 ? static_cast<float>(k - 1) * s.riser : -static_cast<float>(k) * s.riser;
       const float z0 = static_cast<float>(k - 1) * s.tread, z1 = static_cast<float>(k) * s.tread;
       // Ascending treads above the camera are not seen.
       if (cam_s.y() < y + 0.05f) break;
       std::vector<Eigen::Vector2f> nosings;  // (z, y) of the edges that can hide this tread
       if (s.direction < 0)
-        for (int j = 0; j < k; ++j) nosings.emplace_back(static_cast<float>(j) * s.tread, -static_cast<float>(j) * s.riser);
+        for (int j = 0; j < k; ++j)
+          nosings.emplace_back(static_cast<float>(j) * s.tread, -static_cast<float>(j) * s.riser);
       const std::size_t before = scene.regions.size();
       if (k == split_level) {
         add_patch(T_cs, -s.width / 2, -0.15f, z0, z1, y, RegionClass::kStepCandidate, cam_s, nosings);
@@ -99,7 +102,8 @@ class SceneBuilder {
   /// Adds a horizontal rectangle in the floor frame (centre x, z; size along x, z; height).
   void add_box_top(float cx, float cz, float sx, float sz, float height, RegionClass cls) {
     Pose T = T_floor_camera_.inverse();
-    add_patch(T, cx - sx / 2, cx + sx / 2, cz - sz / 2, cz + sz / 2, height, cls, T.inverse().translation(), {});
+    add_patch(T, cx - sx / 2, cx + sx / 2, cz - sz / 2, cz + sz / 2, height, cls, T.inverse().translation(),
+              {});
   }
 
   /// Adds the floor alone (x within +-2 m, z from 0.3 m to `depth`).

@@ -32,27 +32,36 @@ constexpr std::uint32_t kSeed = 5;
 
 /// Why an expected stair was missed, or something false was reported.
 enum class Cause {
-  kNoFloorInView,    ///< perception found no floor, and little floor is in view (truth)
-  kNoFloorFound,     ///< perception found no floor although the truth has it in view
-  kFloorDoubtful,    ///< the stairs stage refused the floor (a lower level nearer the user)
-  kNoCandidates,     ///< perception gave no step candidate
-  kStage,            ///< the stairs stage: candidates there but no validated staircase
-  kWrongDirection,   ///< detected at the true edge, going the wrong way
-  kElsewhere,        ///< detected, but nowhere near a true edge (false positive)
-  kFloorless,        ///< the floorless route (no floor) reported a staircase off the true edge
-  kKind              ///< a TP whose kind is wrong for the user (flight vs one step)
+  kNoFloorInView,   ///< perception found no floor, and little floor is in view (truth)
+  kNoFloorFound,    ///< perception found no floor although the truth has it in view
+  kFloorDoubtful,   ///< the stairs stage refused the floor (a lower level nearer the user)
+  kNoCandidates,    ///< perception gave no step candidate
+  kStage,           ///< the stairs stage: candidates there but no validated staircase
+  kWrongDirection,  ///< detected at the true edge, going the wrong way
+  kElsewhere,       ///< detected, but nowhere near a true edge (false positive)
+  kFloorless,       ///< the floorless route (no floor) reported a staircase off the true edge
+  kKind             ///< a TP whose kind is wrong for the user (flight vs one step)
 };
 const char* to_string(Cause c) {
   switch (c) {
-    case Cause::kNoFloorInView: return "perception: no floor (little in view)";
-    case Cause::kNoFloorFound: return "perception: no floor (floor in view)";
-    case Cause::kFloorDoubtful: return "stairs: floor doubtful";
-    case Cause::kNoCandidates: return "perception: no step candidates";
-    case Cause::kStage: return "stairs: rejected";
-    case Cause::kWrongDirection: return "stairs: wrong direction";
-    case Cause::kElsewhere: return "stairs: detection off the edge";
-    case Cause::kFloorless: return "stairs floorless: off the edge";
-    case Cause::kKind: return "stairs: kind (flight vs one step)";
+    case Cause::kNoFloorInView:
+      return "perception: no floor (little in view)";
+    case Cause::kNoFloorFound:
+      return "perception: no floor (floor in view)";
+    case Cause::kFloorDoubtful:
+      return "stairs: floor doubtful";
+    case Cause::kNoCandidates:
+      return "perception: no step candidates";
+    case Cause::kStage:
+      return "stairs: rejected";
+    case Cause::kWrongDirection:
+      return "stairs: wrong direction";
+    case Cause::kElsewhere:
+      return "stairs: detection off the edge";
+    case Cause::kFloorless:
+      return "stairs floorless: off the edge";
+    case Cause::kKind:
+      return "stairs: kind (flight vs one step)";
   }
   return "?";
 }
@@ -62,11 +71,11 @@ struct Miss {
   long first = 0, last = 0;  ///< frame range (a run of consecutive scored frames with one cause)
   int frames = 0;
   Cause cause = Cause::kStage;
-  StairFrameEval eval;       ///< of the first frame of the run
+  StairFrameEval eval;  ///< of the first frame of the run
   StairVerdict verdict = StairVerdict::kNoCandidates;
   StairKind got = StairKind::kNone;
   int levels = 0;
-  float distance = 0.f;      ///< m, user to the first edge at the first frame of the run
+  float distance = 0.f;  ///< m, user to the first edge at the first frame of the run
 };
 
 /// Recall by the user's distance to the first edge (along the staircase's direction).
@@ -139,13 +148,13 @@ Suite run_suite() {
           (c == Cause::kFloorDoubtful || c == Cause::kStage))
         ++out.descending_stage_misses;
       Miss* last = out.misses.empty() ? nullptr : &out.misses.back();
-      if (sequence && last && last->scene == p.name && last->cause == c && last->last + kSequenceStride == i &&
-          last->eval.outcome == e.outcome) {
+      if (sequence && last && last->scene == p.name && last->cause == c &&
+          last->last + kSequenceStride == i && last->eval.outcome == e.outcome) {
         last->last = i;
         ++last->frames;
       } else {
-        out.misses.push_back({p.name, i, i, 1, c, e, result.verdict, result.detected ? result.kind : StairKind::kNone,
-                              result.levels, dist});
+        out.misses.push_back({p.name, i, i, 1, c, e, result.verdict,
+                              result.detected ? result.kind : StairKind::kNone, result.levels, dist});
       }
     }
   }
@@ -163,10 +172,11 @@ TEST(StairsSynthetic, Suite) {
       std::snprintf(range, sizeof range, "%ld", m.first);
     else
       std::snprintf(range, sizeof range, "%ld-%ld (%d)", m.first, m.last, m.frames);
-    std::printf("miss: %-28s %-16s %-3s %-36s truth %-11s (%d treads%s, edge %.1f m) got %-11s %d levels (%s)\n",
-                m.scene.c_str(), range, to_string(m.eval.outcome), to_string(m.cause), m.eval.truth_label(),
-                m.eval.truth_visible_steps, m.eval.fully_visible ? ", fully visible" : "", m.distance,
-                m.eval.predicted_label(), m.levels, to_string(m.verdict));
+    std::printf(
+        "miss: %-28s %-16s %-3s %-36s truth %-11s (%d treads%s, edge %.1f m) got %-11s %d levels (%s)\n",
+        m.scene.c_str(), range, to_string(m.eval.outcome), to_string(m.cause), m.eval.truth_label(),
+        m.eval.truth_visible_steps, m.eval.fully_visible ? ", fully visible" : "", m.distance,
+        m.eval.predicted_label(), m.levels, to_string(m.verdict));
   }
   std::printf("frames processed per preset:");
   for (const auto& [name, n] : s.processed) std::printf(" %s %ld;", name.c_str(), n);
@@ -180,7 +190,8 @@ TEST(StairsSynthetic, Suite) {
   for (const auto& [kind, kb] : s.kind_bins) {
     std::printf("  %-11s", kind.c_str());
     for (int b = 0; b < kBins; ++b)
-      std::printf(" <%.0f m: %d/%d;", kDistanceBins[b] > 100 ? 99.0 : kDistanceBins[b], kb[static_cast<std::size_t>(b)],
+      std::printf(" <%.0f m: %d/%d;", kDistanceBins[b] > 100 ? 99.0 : kDistanceBins[b],
+                  kb[static_cast<std::size_t>(b)],
                   kb[static_cast<std::size_t>(b)] + kb[static_cast<std::size_t>(b + kBins)]);
     std::printf("\n");
   }
@@ -209,14 +220,15 @@ TEST(StairsSynthetic, Suite) {
       return n;
     };
     const int perception_fn = count({Cause::kNoFloorInView, Cause::kNoFloorFound, Cause::kNoCandidates});
-    std::printf("recall %.4f (%d TP, %d FN; %d FN where perception gave no floor or no candidate), "
-                "fully visible %.4f (%d frames)\n",
-                a.recall(), a.tp, a.fn, perception_fn, a.recall_fully_visible(), a.full_tp + a.full_fn);
+    std::printf(
+        "recall %.4f (%d TP, %d FN; %d FN where perception gave no floor or no candidate), "
+        "fully visible %.4f (%d frames)\n",
+        a.recall(), a.tp, a.fn, perception_fn, a.recall_fully_visible(), a.full_tp + a.full_fn);
     for (const char* kind : {"ascending", "descending"}) {
       const auto it = s.table.by_kind.find(kind);
       if (it != s.table.by_kind.end())
-        std::printf("  %-10s recall %.4f (%d TP, %d FN), fully visible %.4f (%d frames)\n", kind, it->second.recall(),
-                    it->second.tp, it->second.fn, it->second.recall_fully_visible(),
+        std::printf("  %-10s recall %.4f (%d TP, %d FN), fully visible %.4f (%d frames)\n", kind,
+                    it->second.recall(), it->second.tp, it->second.fn, it->second.recall_fully_visible(),
                     it->second.full_tp + it->second.full_fn);
     }
     const double stage_recall = static_cast<double>(a.tp) / std::max(1, a.tp + a.fn - perception_fn);
@@ -243,16 +255,18 @@ TEST(StairsSynthetic, Suite) {
       EXPECT_GE(kb[0], 87) << "descending frames detected within 1 m of the edge (measured 89 of 89)";
     }
     EXPECT_GE(s.bin_tp[0], 175) << "frames detected within 1 m of the first edge (measured 179 of 181)";
-    const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3], far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
-    std::printf("recall from 1 m out: %.4f (%d frames)\n", static_cast<double>(far_tp) / std::max(1, far_tp + far_fn),
-                far_tp + far_fn);
+    const int far_tp = s.bin_tp[1] + s.bin_tp[2] + s.bin_tp[3],
+              far_fn = s.bin_fn[1] + s.bin_fn[2] + s.bin_fn[3];
+    std::printf("recall from 1 m out: %.4f (%d frames)\n",
+                static_cast<double>(far_tp) / std::max(1, far_tp + far_fn), far_tp + far_fn);
     EXPECT_GE(far_tp + far_fn, 100);
     EXPECT_GE(far_tp, 0.95 * (far_tp + far_fn));
     // Every walk is scored from end to end (stairs skipped only while the user is on them).
     for (const auto& p : synth::presets())
       if (p.default_frames > 1) {
         EXPECT_EQ(s.processed.at(p.name), p.default_frames) << p.name;
-        EXPECT_EQ(s.table.by_scene.at(p.name).frames, (p.default_frames + kSequenceStride - 1) / kSequenceStride)
+        EXPECT_EQ(s.table.by_scene.at(p.name).frames,
+                  (p.default_frames + kSequenceStride - 1) / kSequenceStride)
             << p.name;
         EXPECT_GE(s.table.by_scene.at(p.name).tp, 10) << p.name;
       }
@@ -266,8 +280,8 @@ TEST(StairsSynthetic, Suite) {
   {
     SCOPED_TRACE("single steps and curbs told apart from furniture");
     const auto& sc = s.table.by_scene;
-    for (const char* name : {"table_static", "bench_static", "shelves_static", "low_platform_static", "sofa_static",
-                             "corridor_static", "room_clutter_static", "floor_only_static"}) {
+    for (const char* name : {"table_static", "bench_static", "shelves_static", "low_platform_static",
+                             "sofa_static", "corridor_static", "room_clutter_static", "floor_only_static"}) {
       const EvalSummary& e = sc.at(name);
       EXPECT_EQ(e.fp, 0) << name;
       EXPECT_EQ(e.tn, e.frames) << name;
@@ -293,12 +307,13 @@ TEST(StairsSynthetic, Suite) {
 
   {
     SCOPED_TRACE("dimensions and pose");
-    std::printf("riser |err| %.2f cm sigma %.2f (n %d); tread %.2f sigma %.2f (n %d); width %.2f sigma %.2f (n %d)\n"
-                "edge position %.2f cm (n %d), edge line %.2f cm (n %d), yaw %.2f deg sigma %.2f\n",
-                100 * a.riser.mean_abs(), 100 * a.riser.sigma(), a.riser.n, 100 * a.tread.mean_abs(),
-                100 * a.tread.sigma(), a.tread.n, 100 * a.width.mean_abs(), 100 * a.width.sigma(), a.width.n,
-                100 * a.edge_pos.mean_abs(), a.edge_pos.n, 100 * a.edge_line.mean_abs(), a.edge_line.n,
-                a.yaw.mean_abs(), a.yaw.sigma());
+    std::printf(
+        "riser |err| %.2f cm sigma %.2f (n %d); tread %.2f sigma %.2f (n %d); width %.2f sigma %.2f (n %d)\n"
+        "edge position %.2f cm (n %d), edge line %.2f cm (n %d), yaw %.2f deg sigma %.2f\n",
+        100 * a.riser.mean_abs(), 100 * a.riser.sigma(), a.riser.n, 100 * a.tread.mean_abs(),
+        100 * a.tread.sigma(), a.tread.n, 100 * a.width.mean_abs(), 100 * a.width.sigma(), a.width.n,
+        100 * a.edge_pos.mean_abs(), a.edge_pos.n, 100 * a.edge_line.mean_abs(), a.edge_line.n,
+        a.yaw.mean_abs(), a.yaw.sigma());
     EXPECT_GE(a.riser.n, 80);
     EXPECT_GE(a.tread.n, 50);
     EXPECT_LE(a.riser.mean_abs(), 0.01);
@@ -336,7 +351,8 @@ TEST(StairsSynthetic, SingleLevelsOnOtherSeeds) {
   sgtest::SynthStairs p;
   std::map<std::string, std::array<int, 4>> tally;  // tp, fn, fp (incl. off the edge), wrong way
   for (std::uint32_t seed : {6u, 7u}) {
-    for (const char* preset : {"single_step_static", "curb_static", "shelves_static", "low_platform_static"}) {
+    for (const char* preset :
+         {"single_step_static", "curb_static", "shelves_static", "low_platform_static"}) {
       for (long i = 0; i < kStaticFrames; ++i) {
         const StairResult& r = p.step(preset, i, seed, /*cold=*/true);
         const StairFrameEval e = evaluate_stair_frame(r, p.truth);
@@ -346,12 +362,14 @@ TEST(StairsSynthetic, SingleLevelsOnOtherSeeds) {
         t[2] += e.outcome == EvalOutcome::kFP || e.false_positive;
         t[3] += e.wrong_direction;
         if (e.outcome == EvalOutcome::kFN || e.outcome == EvalOutcome::kFP || e.false_positive)
-          std::printf("seed %u %s %ld: %s (%s)\n", seed, preset, i, to_string(e.outcome), to_string(r.verdict));
+          std::printf("seed %u %s %ld: %s (%s)\n", seed, preset, i, to_string(e.outcome),
+                      to_string(r.verdict));
       }
     }
   }
   for (const auto& [preset, t] : tally)
-    std::printf("%-20s seeds 6-7: TP %d FN %d FP %d wrong direction %d\n", preset.c_str(), t[0], t[1], t[2], t[3]);
+    std::printf("%-20s seeds 6-7: TP %d FN %d FP %d wrong direction %d\n", preset.c_str(), t[0], t[1], t[2],
+                t[3]);
   // Measured: single steps 27 of 27, curbs 28 of 28, no shelf nor box reported.
   EXPECT_EQ(tally["single_step_static"][1], 0);
   EXPECT_EQ(tally["curb_static"][1], 0);

@@ -57,11 +57,10 @@ std::map<std::string, int> label_pixels(const synth::PresetFrame& pf, const synt
 }
 
 TEST(StairsWorld2, EveryPresetIsListedAndStatic) {
-  const char* names[] = {"world2_turn_static",     "world2_low_static",    "world2_steep_static",
-                         "world2_legs_static",     "world2_lowrig_static", "world2_shelves_static",
-                         "world2_dressed_static",
-                         "world2_boxes_static",    "world2_sofa_static",   "world2_bench_static",
-                         "world2_lowtable_static", "world2_bed_static"};
+  const char* names[] = {"world2_turn_static",    "world2_low_static",      "world2_steep_static",
+                         "world2_legs_static",    "world2_lowrig_static",   "world2_shelves_static",
+                         "world2_dressed_static", "world2_boxes_static",    "world2_sofa_static",
+                         "world2_bench_static",   "world2_lowtable_static", "world2_bed_static"};
   for (const char* n : names) {
     EXPECT_TRUE(has_preset(n)) << n;
     const synth::PresetInfo* info = synth::find_preset_info(n);
@@ -69,7 +68,8 @@ TEST(StairsWorld2, EveryPresetIsListedAndStatic) {
     EXPECT_EQ(info->default_frames, 1) << n;
   }
   // Kept apart from the lists the other suites run.
-  for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::rig_presets(), &synth::walk_presets()})
+  for (const auto* l :
+       {&synth::presets(), &synth::world_presets(), &synth::rig_presets(), &synth::walk_presets()})
     for (const auto& p : *l) EXPECT_EQ(p.name.rfind("world2_", 0), std::string::npos) << p.name;
 }
 
@@ -124,7 +124,8 @@ TEST(StairsWorld2, TurnLabelsBothFlightsFromTheLanding) {
       const synth::PresetFrame pf = synth::build_preset_frame("world2_turn_static", i, seed);
       ++frames;
       ASSERT_EQ(truth.stairs.size(), 2u);
-      EXPECT_TRUE(truth.floor_visible || truth.stairs[0].visible_steps.size() + truth.stairs[1].visible_steps.size() > 0);
+      EXPECT_TRUE(truth.floor_visible ||
+                  truth.stairs[0].visible_steps.size() + truth.stairs[1].visible_steps.size() > 0);
       const Eigen::Vector3f view_dir = truth.T_world_camera.linear().col(2);
       for (const StairTruth& s : truth.stairs) {
         EXPECT_EQ(s.user_step, 0);
@@ -133,14 +134,17 @@ TEST(StairsWorld2, TurnLabelsBothFlightsFromTheLanding) {
         (s.kind == StairKind::kAscending ? up_seen : down_seen) += 1;
         full += s.first_edge_visible && s.both_ends_visible;
         // The angle between the view's heading and the flight's direction of travel.
-        const Eigen::Vector3f t = pf.scene.stairs[static_cast<std::size_t>(s.id)].T_world_stair.linear().col(2);
+        const Eigen::Vector3f t =
+            pf.scene.stairs[static_cast<std::size_t>(s.id)].T_world_stair.linear().col(2);
         const Eigen::Vector2f a(view_dir.x(), view_dir.y()), b(t.x(), t.y());
         const float ang = rad2deg(std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.f, 1.f)));
         oblique += ang >= 35.f;
       }
     }
-  std::printf("turn rendered: %d frames, %d flights with >= 2 treads in view (%d up, %d down), %d fully, %d from >= 35 deg\n",
-              frames, seen, up_seen, down_seen, full, oblique);
+  std::printf(
+      "turn rendered: %d frames, %d flights with >= 2 treads in view (%d up, %d down), %d fully, %d from >= "
+      "35 deg\n",
+      frames, seen, up_seen, down_seen, full, oblique);
   EXPECT_GE(seen, frames / 2);
   EXPECT_GE(up_seen, 2);
   EXPECT_GE(down_seen, 2);
@@ -198,8 +202,8 @@ TEST(StairsWorld2, LowRisersAndLongGoings) {
   int low = 0, up = 0, down = 0, full = 0, seen = 0;
   check_flights("world2_low_static", {0.08f, 0.12f, 0.30f, 0.60f}, low, up, down);
   check_rendered_flights("world2_low_static", full, seen);
-  std::printf("low: 2R+T < 50 cm on %d of %ld; %d up, %d down; rendered %d seen, %d fully\n", low,
-              kBuilt * 2, up, down, seen, full);
+  std::printf("low: 2R+T < 50 cm on %d of %ld; %d up, %d down; rendered %d seen, %d fully\n", low, kBuilt * 2,
+              up, down, seen, full);
   EXPECT_GE(low, 3);  // the codes' 2R+T >= 50 cm does not bound them
   EXPECT_GE(up, static_cast<int>(kBuilt / 3));
   EXPECT_GE(down, static_cast<int>(kBuilt / 3));
@@ -238,15 +242,17 @@ void check_tread_heights(const synth::Scene& scene, const char* preset, long vie
     }
   for (const synth::StairSpec& st : scene.stairs)
     if (st.kind == StairKind::kAscending) {
-      EXPECT_NEAR(st.T_world_stair.translation().z(), st.tread_height(1), 1e-4f) << preset << " view " << view;
+      EXPECT_NEAR(st.T_world_stair.translation().z(), st.tread_height(1), 1e-4f)
+          << preset << " view " << view;
     }
 }
 
 TEST(StairsWorld2, TreadLabelsAtTheBuiltHeights) {
-  for (const char* preset : {"world2_turn_static", "world2_low_static", "world2_steep_static", "world2_dressed_static",
-                             "world2_legs_static", "world2_lowrig_static"})
+  for (const char* preset : {"world2_turn_static", "world2_low_static", "world2_steep_static",
+                             "world2_dressed_static", "world2_legs_static", "world2_lowrig_static"})
     for (std::uint32_t seed : kSeeds)
-      for (long i = 0; i < kBuilt; ++i) check_tread_heights(synth::build_preset_frame(preset, i, seed).scene, preset, i);
+      for (long i = 0; i < kBuilt; ++i)
+        check_tread_heights(synth::build_preset_frame(preset, i, seed).scene, preset, i);
 }
 
 // Dressed flights: the codes' riser and going, the wearer on the floor (on the carpet where there
@@ -335,7 +341,8 @@ TEST(StairsWorld2, LegsInViewBeforeAFlight) {
       EXPECT_LE(camera_height(pf), 1.6f + 1e-4f);
       if (i >= kRendered) continue;
       const auto px = label_pixels(pf);
-      const int n = (px.count("wearer_leg") ? px.at("wearer_leg") : 0) + (px.count("wearer_foot") ? px.at("wearer_foot") : 0);
+      const int n = (px.count("wearer_leg") ? px.at("wearer_leg") : 0) +
+                    (px.count("wearer_foot") ? px.at("wearer_foot") : 0);
       in_view += n >= 500;
       ++views;
       if (tilt >= 65.f) {
@@ -386,7 +393,8 @@ float solid_top(const synth::Scene& scene, const std::string& label, bool highes
     if (so.label != label) continue;
     float z = -1e9f;
     for (int f = so.first_face; f < so.first_face + so.face_count; ++f)
-      for (const Eigen::Vector3f& v : scene.faces()[static_cast<std::size_t>(f)].vertices) z = std::max(z, v.z());
+      for (const Eigen::Vector3f& v : scene.faces()[static_cast<std::size_t>(f)].vertices)
+        z = std::max(z, v.z());
     top = highest ? std::max(top, z) : std::min(top, z);
   }
   return top;
@@ -394,13 +402,23 @@ float solid_top(const synth::Scene& scene, const std::string& label, bool highes
 
 TEST(StairsWorld2, FurnitureHasNoStairLabelAndIsInView) {
   const std::vector<Furniture> all = {
-      {"world2_shelves_static", {"shelf_board", "shelf_side", "shelf_back", "books"}, "shelf_board", 0.8f, 2.0f},
+      {"world2_shelves_static",
+       {"shelf_board", "shelf_side", "shelf_back", "books"},
+       "shelf_board",
+       0.8f,
+       2.0f},
       {"world2_boxes_static", {"box"}, "box", 0.15f, 1.3f},
-      {"world2_sofa_static", {"sofa", "sofa_back", "sofa_arm", "sofa_foot", "ottoman", "table", "table_leg"}, "sofa",
-       0.38f, 0.48f},
+      {"world2_sofa_static",
+       {"sofa", "sofa_back", "sofa_arm", "sofa_foot", "ottoman", "table", "table_leg"},
+       "sofa",
+       0.38f,
+       0.48f},
       {"world2_bench_static", {"bench", "bench_leg", "bench_shelf", "shoe"}, "bench", 0.40f, 0.50f},
       {"world2_lowtable_static", {"table", "table_leg", "table_shelf", "rug"}, "table", 0.35f, 0.50f},
-      {"world2_bed_static", {"bed", "mattress", "headboard", "pillow", "bench", "bedside_table"}, "mattress", 0.30f,
+      {"world2_bed_static",
+       {"bed", "mattress", "headboard", "pillow", "bench", "bedside_table"},
+       "mattress",
+       0.30f,
        0.65f},
   };
   for (const Furniture& fu : all) {
@@ -496,7 +514,8 @@ TEST(StairsWorld2, SensorModelsKinectV2NativeAndStructuredLight) {
         later += za - zb >= 0.005f;
       }
   }
-  std::printf("tof-v2: %ld of %ld readings >= 5 mm late (multipath), at most %.1f mm\n", later, valid, 1000 * most);
+  std::printf("tof-v2: %ld of %ld readings >= 5 mm late (multipath), at most %.1f mm\n", later, valid,
+              1000 * most);
   EXPECT_GE(later, valid / 200);
   EXPECT_LE(most, tof.multipath_m + 0.0011f);
 
@@ -549,7 +568,8 @@ std::vector<std::string> split_env(const char* name, const char* fallback) {
 
 synth::SynthOptions noise_options(const std::string& noise) {
   synth::SynthOptions o;
-  if (!synth::sensor_options(noise, o)) ADD_FAILURE() << "unknown NOISE " << noise << ": " << synth::sensor_names();
+  if (!synth::sensor_options(noise, o))
+    ADD_FAILURE() << "unknown NOISE " << noise << ": " << synth::sensor_names();
   return o;
 }
 
@@ -566,9 +586,10 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
   const long frames = std::atol(split_env("SG_WORLD2_FRAMES", "24").front().c_str());
   // A fixed mounting instead of the preset's draw (SG_WORLD2_HEIGHT m, SG_WORLD2_TILT deg): to tell
   // what the rig does from what the scene does.
-  const std::string height = split_env("SG_WORLD2_HEIGHT", "nan").front(), tilt = split_env("SG_WORLD2_TILT", "nan").front();
-  std::printf("%-24s %-8s %-10s %6s %4s %4s %4s %4s %5s %10s %9s %9s\n", "preset", "noise", "seeds", "frames", "TP",
-              "FP", "FN", "TN", "skip", "full", "riser cm", "tread cm");
+  const std::string height = split_env("SG_WORLD2_HEIGHT", "nan").front(),
+                    tilt = split_env("SG_WORLD2_TILT", "nan").front();
+  std::printf("%-24s %-8s %-10s %6s %4s %4s %4s %4s %5s %10s %9s %9s\n", "preset", "noise", "seeds", "frames",
+              "TP", "FP", "FN", "TN", "skip", "full", "riser cm", "tread cm");
   std::map<std::string, int> why;
   for (const std::string& preset : presets) {
     EvalSummary s;
@@ -586,21 +607,24 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
           const std::string reason = r.detected ? std::string("wrong place or kind: ") + to_string(r.kind)
                                                 : std::string(to_string(r.verdict));
           ++why[std::string(to_string(e.outcome)) + " " + reason];
-          std::printf("  miss %s seed %u #%ld: %s%s truth %s (%d treads) got %s %d levels (%s) riser %.1f tread %.1f "
-                      "floor %d (camera %.2f m, truth %.2f m)\n",
-                      preset.c_str(), seed, i, to_string(e.outcome), e.fully_visible ? " fully visible" : "",
-                      to_string(e.truth_kind), e.truth_visible_steps, r.detected ? to_string(r.kind) : "-", r.levels,
-                      to_string(r.verdict), 100 * r.riser_m, 100 * r.tread_m, p.scene.floor_found,
-                      p.scene.floor_found ? p.scene.camera_height : 0.f, p.truth.camera_height_m);
+          std::printf(
+              "  miss %s seed %u #%ld: %s%s truth %s (%d treads) got %s %d levels (%s) riser %.1f tread %.1f "
+              "floor %d (camera %.2f m, truth %.2f m)\n",
+              preset.c_str(), seed, i, to_string(e.outcome), e.fully_visible ? " fully visible" : "",
+              to_string(e.truth_kind), e.truth_visible_steps, r.detected ? to_string(r.kind) : "-", r.levels,
+              to_string(r.verdict), 100 * r.riser_m, 100 * r.tread_m, p.scene.floor_found,
+              p.scene.floor_found ? p.scene.camera_height : 0.f, p.truth.camera_height_m);
           for (const StairTruth& t : p.truth.stairs) {
             // Where a detection stood against each labelled flight: its origin's distance to the
             // flight's first edge line (eval matches within 25 cm).
             const Eigen::Vector3f d = r.T_camera_stair.translation() - t.T_camera_stair.translation();
             const Eigen::Vector3f x = t.T_camera_stair.linear().col(0);
-            std::printf("       truth %s riser %.1f tread %.1f, %zu treads in view%s%s; detection %.2f m off its edge line\n",
-                        to_string(t.kind), 100 * t.riser_m, 100 * t.tread_m, t.visible_steps.size(),
-                        t.first_edge_visible ? ", first edge" : "", t.both_ends_visible ? " (both ends)" : "",
-                        r.detected ? (d - d.dot(x) * x).norm() : 0.f);
+            std::printf(
+                "       truth %s riser %.1f tread %.1f, %zu treads in view%s%s; detection %.2f m off its "
+                "edge line\n",
+                to_string(t.kind), 100 * t.riser_m, 100 * t.tread_m, t.visible_steps.size(),
+                t.first_edge_visible ? ", first edge" : "", t.both_ends_visible ? " (both ends)" : "",
+                r.detected ? (d - d.dot(x) * x).norm() : 0.f);
           }
         }
       }
@@ -609,7 +633,8 @@ TEST(StairsWorld2, DISABLED_MeasureDetector) {
     for (const auto& x : seeds) seed_list += (seed_list.empty() ? "" : ",") + x;
     std::printf("%-24s %-8s %-10s %6d %4d %4d %4d %4d %5d %4d/%-4d  %4.2f(%2d) %4.2f(%2d)\n", preset.c_str(),
                 noise.c_str(), seed_list.c_str(), s.frames, s.tp, s.fp, s.fn, s.tn, s.skipped, s.full_tp,
-                s.full_tp + s.full_fn, 100 * s.riser.mean_abs(), s.riser.n, 100 * s.tread.mean_abs(), s.tread.n);
+                s.full_tp + s.full_fn, 100 * s.riser.mean_abs(), s.riser.n, 100 * s.tread.mean_abs(),
+                s.tread.n);
     std::fflush(stdout);
   }
   for (const auto& [reason, n] : why) std::printf("why: %4d  %s\n", n, reason.c_str());
@@ -632,7 +657,8 @@ TEST(StairsWorld2, TurnSeenFromTheLandingIsTold) {
     wrong_direction += e.wrong_direction;
     split += p.stage.floorless_trace().landing_split && r.detected;
   }
-  std::printf("turn from the landing, seed 912: %d of 24 told at a true edge, %d by the landing split\n", tp, split);
+  std::printf("turn from the landing, seed 912: %d of 24 told at a true edge, %d by the landing split\n", tp,
+              split);
   EXPECT_GE(split, 2) << "no view was split at the landing";
   EXPECT_GE(tp, 13);
   EXPECT_EQ(wrong_direction, 0);

@@ -27,7 +27,7 @@ using namespace stairguide;
 namespace {
 
 constexpr std::uint32_t kSeed = 20261123u;  // test_perception's seed: the same walks
-constexpr int kMinWallOrRiserPixels = 200;   // as test_perception: a wall or riser "visible"
+constexpr int kMinWallOrRiserPixels = 200;  // as test_perception: a wall or riser "visible"
 
 struct WalkFigures {
   int frames = 0, checked = 0, ok = 0, ok_without_carry = 0, carried = 0, carried_checked = 0;
@@ -94,10 +94,11 @@ WalkFigures run_walk(const std::string& preset, long frames, const synth::SynthO
                   truth->wall_or_riser_pixels, sc.manhattan_why.c_str());
     }
   }
-  std::printf("%-28s frames %4d | odometry failures %d | Manhattan within 2 deg %d/%d (%d without the odometry) | "
-              "held frame given to %d (%d where a wall is in view), worst %.2f deg | off %d\n",
-              preset.c_str(), W.frames, W.odometry_failures, W.ok, W.checked, W.ok_without_carry, W.carried,
-              W.carried_checked, W.worst_carried, W.wrong);
+  std::printf(
+      "%-28s frames %4d | odometry failures %d | Manhattan within 2 deg %d/%d (%d without the odometry) | "
+      "held frame given to %d (%d where a wall is in view), worst %.2f deg | off %d\n",
+      preset.c_str(), W.frames, W.odometry_failures, W.ok, W.checked, W.ok_without_carry, W.carried,
+      W.carried_checked, W.worst_carried, W.wrong);
   return W;
 }
 
@@ -110,14 +111,16 @@ struct Walk {
   const char* preset;
   long frames;
   int misses;
-  bool real_like_noise = false;  // synth::with_real_kinect_noise(): depth noise correlated as the real sensor's
+  bool real_like_noise =
+      false;  // synth::with_real_kinect_noise(): depth noise correlated as the real sensor's
 };
 class WalkManhattan : public ::testing::TestWithParam<Walk> {};
 
 TEST_P(WalkManhattan, FrameHeldByOurOdometry) {
   const Walk walk = GetParam();
   const WalkFigures W =
-      run_walk(walk.preset, walk.frames, walk.real_like_noise ? synth::with_real_kinect_noise() : synth::SynthOptions{});
+      run_walk(walk.preset, walk.frames,
+               walk.real_like_noise ? synth::with_real_kinect_noise() : synth::SynthOptions{});
   EXPECT_EQ(W.wrong, 0) << "a Manhattan frame more than 2 deg off";
   EXPECT_EQ(W.odometry_failures, 0);
   EXPECT_LE(W.worst_carried, 2.f);
@@ -134,8 +137,7 @@ INSTANTIATE_TEST_SUITE_P(
         // the wall shows only as a strip too narrow to make a frame of its own. Measured 122/123
         // (95/123 view by view): frame 33, facing the side wall at the start, sees a 515 px strip
         // of it before any view has made a frame to hold.
-        Walk{"ascending_turn_fast", 300, 1},
-        Walk{"ascending_approach_climb", 600, 0},  // 374/374
+        Walk{"ascending_turn_fast", 300, 1}, Walk{"ascending_approach_climb", 600, 0},  // 374/374
         // No wall or riser face in view on the way down: no frame may be off with the flight in view.
         Walk{"descending_approach_descend", 600, 0}, Walk{"descending_people_approach", 300, 0}),
     [](const ::testing::TestParamInfo<Walk>& info) { return std::string(info.param.preset); });
@@ -146,10 +148,12 @@ INSTANTIATE_TEST_SUITE_P(
 // Measured: the fast turn 121/123 (91 view by view), the approach and climb 374/374 (not run
 // here: 12 s); no frame off on either or on the walk down past a person (7 views given the held
 // frame there, within 1.36 deg).
-INSTANTIATE_TEST_SUITE_P(
-    WalksRealLikeNoise, WalkManhattan,
-    ::testing::Values(Walk{"ascending_turn_fast", 300, 2, true}, Walk{"descending_people_approach", 300, 0, true}),
-    [](const ::testing::TestParamInfo<Walk>& info) { return std::string(info.param.preset); });
+INSTANTIATE_TEST_SUITE_P(WalksRealLikeNoise, WalkManhattan,
+                         ::testing::Values(Walk{"ascending_turn_fast", 300, 2, true},
+                                           Walk{"descending_people_approach", 300, 0, true}),
+                         [](const ::testing::TestParamInfo<Walk>& info) {
+                           return std::string(info.param.preset);
+                         });
 
 // The real 7-Scenes kitchen, hand-held, every frame: perception alone (the frame each view makes,
 // tracked from frame to frame), then with our odometry holding the frame in the world. Its walls
@@ -187,7 +191,8 @@ TEST(WalkManhattanReal, KitchenFrameHeldByOurOdometryHoldsStillInTheWorld) {
     }
     if (!with_odometry) mean = world.mean_yaw();
     std::vector<float> dev;
-    for (const float a : world.yaws()) dev.push_back(std::fabs(sg_test::wrap45(a - mean)) / sg_test::kManhattanDeg);
+    for (const float a : world.yaws())
+      dev.push_back(std::fabs(sg_test::wrap45(a - mean)) / sg_test::kManhattanDeg);
     std::sort(dev.begin(), dev.end());
     S.views = dev.size();
     if (!dev.empty()) {
@@ -197,9 +202,10 @@ TEST(WalkManhattanReal, KitchenFrameHeldByOurOdometryHoldsStillInTheWorld) {
     return S;
   };
   const Spread alone = run(false), held = run(true);
-  std::printf("kitchen, 300 frames: frame on %zu views, p95 %.2f, worst %.2f deg from their mean in the world; held "
-              "by our odometry: %zu views (%zu given the held frame), p95 %.2f, worst %.2f deg\n",
-              alone.views, alone.p95, alone.worst, held.views, held.held, held.p95, held.worst);
+  std::printf(
+      "kitchen, 300 frames: frame on %zu views, p95 %.2f, worst %.2f deg from their mean in the world; held "
+      "by our odometry: %zu views (%zu given the held frame), p95 %.2f, worst %.2f deg\n",
+      alone.views, alone.p95, alone.worst, held.views, held.held, held.p95, held.worst);
   ASSERT_GE(alone.views, 150u) << "the kitchen's floor and walls are seen on 198 of its 300 frames";
   // Measured: alone p95 1.93, worst 6.15 deg (198 views); held p95 1.14, worst 2.24 deg (198).
   EXPECT_GE(held.views, alone.views);
@@ -249,15 +255,16 @@ TEST(WalkManhattanRules, HeldFrameRulesOnKnownPoses) {
     P.apply_odometry(link_of(truth, track), t, sc);
     return sc;
   };
-  const SceneResult carried = frame_100([&](Perception& P) { P.hold_manhattan(seen, link_of(seen_truth, 1)); }, 1,
-                                        f.timestamp);
+  const SceneResult carried =
+      frame_100([&](Perception& P) { P.hold_manhattan(seen, link_of(seen_truth, 1)); }, 1, f.timestamp);
   ASSERT_TRUE(carried.manhattan_carried);
   // Carried by exact poses, the frame keeps the error the view that saw it made, nothing more.
   EXPECT_NEAR(sg_test::manhattan_yaw_error_deg(carried, truth), seen_error, 0.05f);
   EXPECT_LE(seen_error, 2.f);
   EXPECT_NEAR(carried.manhattan_carried_age, f.timestamp - seen.timestamp, 1e-3);
-  EXPECT_FALSE(frame_100([&](Perception& P) { P.hold_manhattan(seen, link_of(seen_truth, 1)); }, 2, f.timestamp)
-                   .manhattan_found)
+  EXPECT_FALSE(
+      frame_100([&](Perception& P) { P.hold_manhattan(seen, link_of(seen_truth, 1)); }, 2, f.timestamp)
+          .manhattan_found)
       << "carried across a change of the odometry's track";
   EXPECT_FALSE(frame_100([&](Perception& P) { P.hold_manhattan(seen, link_of(seen_truth, 1)); }, 1,
                          seen.timestamp + cfg.manhattan.carry_seconds + 0.1)

@@ -41,8 +41,8 @@ struct PairOutcome {
   std::string last;      ///< the last frame's state, for the report
 };
 
-PairOutcome stand(const PipelineConfig& cfg, const std::string& preset, long view, std::uint32_t seed, Rig rig,
-                  synth::RealSensor sensor) {
+PairOutcome stand(const PipelineConfig& cfg, const std::string& preset, long view, std::uint32_t seed,
+                  Rig rig, synth::RealSensor sensor) {
   synth::SynthOptions o = synth::with_real_artefacts(sensor);
   o.camera_height_m = rig.height_m;
   o.camera_tilt_deg = rig.tilt_deg;
@@ -71,7 +71,7 @@ PairOutcome stand(const PipelineConfig& cfg, const std::string& preset, long vie
 
 struct Tally {
   int pairs = 0, told = 0;
-  std::vector<int> first_frames;   ///< of the pairs told
+  std::vector<int> first_frames;    ///< of the pairs told
   std::vector<std::string> misses;  ///< what was missed, and the last frame's state
   void add(const PairOutcome& o, const char* what) {
     if (!o.in_view) return;
@@ -80,7 +80,8 @@ struct Tally {
     told += good;
     if (good) first_frames.push_back(o.first_frame);
     if (good) return;
-    misses.push_back(std::string(what) + ": first " + std::to_string(o.first_frame) + ", last frame " + o.last);
+    misses.push_back(std::string(what) + ": first " + std::to_string(o.first_frame) + ", last frame " +
+                     o.last);
     std::printf("standing: MISSED %s\n", misses.back().c_str());
   }
 };
@@ -104,7 +105,8 @@ void write_json(const Tally& t, const char* path) {
                t.pairs ? static_cast<double>(t.told) / t.pairs : 0.0, kFrames);
   std::fprintf(out, "\"first_frame_median\": %d, \"first_frame_max\": %d, \"misses\": [",
                f.empty() ? -1 : f[f.size() / 2], f.empty() ? -1 : f.back());
-  for (std::size_t i = 0; i < t.misses.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_string(t.misses[i]).c_str());
+  for (std::size_t i = 0; i < t.misses.size(); ++i)
+    std::fprintf(out, "%s%s", i ? ", " : "", json_string(t.misses[i]).c_str());
   std::fprintf(out, "]}\n");
   std::fclose(out);
 }
@@ -115,7 +117,8 @@ void run_grid(Tally& t, const std::vector<Rig>& rigs, const std::vector<std::uin
     for (const Rig& rig : rigs)
       for (const char* preset : {"world_ascending_static", "world_descending_static", "world2_lowrig_static"})
         for (long v = 0; v < views; ++v) {
-          const synth::RealSensor sensor = (v + seed) % 2 ? synth::RealSensor::kKinectV1 : synth::RealSensor::kKinectV2;
+          const synth::RealSensor sensor =
+              (v + seed) % 2 ? synth::RealSensor::kKinectV1 : synth::RealSensor::kKinectV2;
           const PairOutcome o = stand(cfg, preset, v, seed, rig, sensor);
           char what[160];
           std::snprintf(what, sizeof what, "rig %.1f m %.0f deg, %s #%ld seed %u", rig.height_m, rig.tilt_deg,
@@ -135,11 +138,13 @@ std::vector<std::uint32_t> env_seeds(const char* name, std::vector<std::uint32_t
 
 TEST(StandingWearer, FloorAndStairsWithinASecond) {
   // Low and high rigs, shallow and steep tilts: the corners of the range and the waist rig.
-  const std::vector<Rig> rigs = {{0.6f, 25.f}, {0.6f, 50.f}, {0.9f, 35.f}, {1.3f, 45.f}, {1.8f, 20.f}, {1.8f, 70.f}};
+  const std::vector<Rig> rigs = {{0.6f, 25.f}, {0.6f, 50.f}, {0.9f, 35.f},
+                                 {1.3f, 45.f}, {1.8f, 20.f}, {1.8f, 70.f}};
   Tally t;
   run_grid(t, rigs, {4301u}, 1);
-  std::printf("standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames\n",
-              t.told, t.pairs, kFrames);
+  std::printf(
+      "standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames\n",
+      t.told, t.pairs, kFrames);
   ASSERT_GE(t.pairs, 6) << "too few rigs see a flight: the grid tests nothing";
   EXPECT_GE(t.told, t.pairs - 1);
 }
@@ -151,8 +156,10 @@ TEST(StandingWearer, DISABLED_Measure) {
   const char* v = std::getenv("SG_STANDING_VIEWS");
   Tally t;
   run_grid(t, rigs, env_seeds("SG_STANDING_SEEDS", {4301u, 4302u}), v ? std::atol(v) : 3);
-  std::printf("standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames (%.1f%%)\n",
-              t.told, t.pairs, kFrames, t.pairs ? 100.0 * t.told / t.pairs : 0.0);
+  std::printf(
+      "standing wearer: %d of %d (rig, flight) pairs with the floor and the flight within %ld frames "
+      "(%.1f%%)\n",
+      t.told, t.pairs, kFrames, t.pairs ? 100.0 * t.told / t.pairs : 0.0);
   if (const char* path = std::getenv("SG_STANDING_JSON")) write_json(t, path);
 }
 

@@ -47,7 +47,8 @@ std::optional<long> Context::int_option(const std::string& name, long lo, long h
     long n = std::stol(*v, &used);
     if (used != v->size()) throw std::invalid_argument(*v);
     if (n < lo || n > hi)
-      throw UsageError(name + " " + *v + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      throw UsageError(name + " " + *v + " is out of range [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
     return n;
   } catch (const std::logic_error&) {
     throw UsageError(name + " expects a whole number, got '" + *v + "'");
@@ -74,8 +75,9 @@ void print_help(std::FILE* out) {
   std::sort(cmds.begin(), cmds.end(),
             [](const auto& a, const auto& b) { return std::string(a.name) < b.name; });
   for (const auto& c : cmds) std::fprintf(out, "  %-58s %s\n", c.usage, c.summary);
-  std::fprintf(out, "\nEvery command takes --config FILE (default: $STAIRGUIDE_CONFIG, then\n"
-                    "/etc/stairguide/stairguide.yaml, then the source tree's config/stairguide.yaml).\n");
+  std::fprintf(out,
+               "\nEvery command takes --config FILE (default: $STAIRGUIDE_CONFIG, then\n"
+               "/etc/stairguide/stairguide.yaml, then the source tree's config/stairguide.yaml).\n");
 }
 
 /// False for a command that is given its file (check-config FILE) or needs no config (synth

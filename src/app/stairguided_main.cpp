@@ -152,9 +152,10 @@ __attribute__((section(".preinit_array"),
 /// message that needs no allocation when even logging cannot have any.
 void say_out_of_memory(const char* where) noexcept {
   try {
-    spdlog::critical("out of memory (std::bad_alloc) {}: the memory limit (ulimit -v, the unit's MemoryMax=) "
-                     "is too small for the daemon; exiting",
-                     where);
+    spdlog::critical(
+        "out of memory (std::bad_alloc) {}: the memory limit (ulimit -v, the unit's MemoryMax=) "
+        "is too small for the daemon; exiting",
+        where);
     spdlog::default_logger()->flush();
   } catch (...) {
     static const char msg[] = "stairguided: out of memory (std::bad_alloc); exiting\n";
@@ -242,9 +243,10 @@ int daemon_main(int argc, char** argv) {
   opt.max_frames = args.frames;
   opt.perception_delay_s = args.perception_delay;
   if (opt.perception_delay_s > 0.0)
-    spdlog::warn("--perception-delay {:.3f} s: each frame is held that long before perception (a test of a slow "
-                 "machine)",
-                 opt.perception_delay_s);
+    spdlog::warn(
+        "--perception-delay {:.3f} s: each frame is held that long before perception (a test of a slow "
+        "machine)",
+        opt.perception_delay_s);
 
   runtime::SystemdNotifier notifier;
   runtime::Runtime rt(config, opt, &notifier);
@@ -329,11 +331,11 @@ int daemon_main(int argc, char** argv) {
         static_cast<unsigned long long>(st.odometry_frames_lost),
         static_cast<unsigned long long>(st.perception_frames),
         static_cast<unsigned long long>(st.perception_skipped), st.fps, st.latency_p50_ms, st.latency_p99_ms,
-        st.state.c_str(), st.traversal_state.c_str(), st.traversal_step, st.traversal_left, st.traversal_known,
-        static_cast<unsigned long long>(st.cues), static_cast<unsigned long long>(st.cues_sounded),
-        st.cue_latency_p50_ms, st.cue_latency_p99_ms, st.last_cue.empty() ? "-" : st.last_cue.c_str(),
-        static_cast<unsigned long long>(st.cues_lost), st.odometry_lag_p99_ms,
-        static_cast<unsigned long long>(st.timestamps_replaced));
+        st.state.c_str(), st.traversal_state.c_str(), st.traversal_step, st.traversal_left,
+        st.traversal_known, static_cast<unsigned long long>(st.cues),
+        static_cast<unsigned long long>(st.cues_sounded), st.cue_latency_p50_ms, st.cue_latency_p99_ms,
+        st.last_cue.empty() ? "-" : st.last_cue.c_str(), static_cast<unsigned long long>(st.cues_lost),
+        st.odometry_lag_p99_ms, static_cast<unsigned long long>(st.timestamps_replaced));
   }
   std::fflush(stdout);
   spdlog::default_logger()->flush();

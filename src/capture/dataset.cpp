@@ -209,7 +209,8 @@ DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& optio
   std::size_t prev_rgb = 0;
   bool have_prev = false;
   if (has_rgb && !file_order)
-    std::stable_sort(rgb.begin(), rgb.end(), [](const ListEntry& a, const ListEntry& b) { return a.t < b.t; });
+    std::stable_sort(rgb.begin(), rgb.end(),
+                     [](const ListEntry& a, const ListEntry& b) { return a.t < b.t; });
   for (const auto& e : depth) {
     Pair p;
     p.t_depth = e.t;
@@ -231,8 +232,8 @@ DatasetSource::DatasetSource(const std::string& dir, const DatasetOptions& optio
         }
       } else {
         // Nearest colour timestamp by binary search.
-        auto it =
-            std::lower_bound(rgb.begin(), rgb.end(), e.t, [](const ListEntry& a, double t) { return a.t < t; });
+        auto it = std::lower_bound(rgb.begin(), rgb.end(), e.t,
+                                   [](const ListEntry& a, double t) { return a.t < t; });
         if (it != rgb.end()) best = &*it;
         if (it != rgb.begin() && (!best || std::abs((it - 1)->t - e.t) <= std::abs(best->t - e.t)))
           best = &*(it - 1);
@@ -282,7 +283,8 @@ ReadResult DatasetSource::read(RgbdFrame& out) {
   // Existence first: imread cannot tell a missing file from a corrupt one.
   // And readable: an unreadable image read as "corrupt" (issue 41).
   if (const std::string why = why_unreadable(p.depth_path); !why.empty())
-    return fail(p.depth_path, why == "no such file" ? "depth image missing" : "cannot read depth image (" + why + ")");
+    return fail(p.depth_path,
+                why == "no such file" ? "depth image missing" : "cannot read depth image (" + why + ")");
   cv::Mat raw = cv::imread(p.depth_path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) return fail(p.depth_path, "cannot decode depth image (corrupt or not an image)");
   if (raw.type() != CV_16UC1)

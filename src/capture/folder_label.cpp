@@ -108,7 +108,8 @@ bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
     t.id = s.optional<int>("id", static_cast<int>(f.stairs.size()));
     const std::string kind = s.scalar<std::string>("kind");
     if (!parse_stair_kind(kind, t.kind) || t.kind == StairKind::kNone)
-      throw s.here(sn["kind"], "unknown stair kind '" + kind + "' (ascending, descending, single_step, curb)");
+      throw s.here(sn["kind"],
+                   "unknown stair kind '" + kind + "' (ascending, descending, single_step, curb)");
     if (s.has("down")) {
       t.down = s.scalar<bool>("down");
       if ((t.kind == StairKind::kAscending || t.kind == StairKind::kSingleStep) && t.down)

@@ -42,10 +42,12 @@ std::unique_ptr<FrameSource> open_synth(const std::string& input) {
   if (parts.size() >= 3 && !parts[2].empty()) frames = parse_count(parts[2], input, "FRAMES");
   if (frames == 0) throw SourceError("input '" + input + "': FRAMES must be at least 1");
   std::uint32_t seed = 1;
-  if (parts.size() >= 4 && !parts[3].empty()) seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
+  if (parts.size() >= 4 && !parts[3].empty())
+    seed = static_cast<std::uint32_t>(parse_count(parts[3], input, "SEED"));
   synth::SynthOptions options;
   if (parts.size() == 5 && !synth::sensor_options(parts[4], options))
-    throw SourceError("input '" + input + "': NOISE must be " + synth::sensor_names() + ", got '" + parts[4] + "'");
+    throw SourceError("input '" + input + "': NOISE must be " + synth::sensor_names() + ", got '" + parts[4] +
+                      "'");
   // An unknown scene name is reported by make_source (its message lists the presets).
   return synth::make_source(parts[1], frames < 0 ? 1 : frames, seed, options);
 }

@@ -225,8 +225,9 @@ void check_pcd_header(const std::string& path) {
 RgbdFrame read_pcd_frame(const std::string& path) {
   std::error_code ec;
   if (const std::string why = why_unreadable(path); !why.empty() && !fs::is_directory(path, ec))
-    throw SourceError(path + ": " + (why == "no such file" ? "PCD file missing (no such file)"
-                                                           : "cannot read the PCD file (" + why + ")"));
+    throw SourceError(path + ": " +
+                      (why == "no such file" ? "PCD file missing (no such file)"
+                                             : "cannot read the PCD file (" + why + ")"));
   if (!fs::is_regular_file(path, ec)) throw SourceError(path + ": not a regular file");
   check_pcd_header(path);
   pcl::PCLPointCloud2 blob;
@@ -276,8 +277,9 @@ RgbdFrame read_pcd_frame(const std::string& path) {
 RgbdFrame read_depth_png_frame(const std::string& path) {
   std::error_code ec;
   if (const std::string why = why_unreadable(path); !why.empty() && !fs::is_directory(path, ec))
-    throw SourceError(path + ": " + (why == "no such file" ? "depth image missing (no such file)"
-                                                           : "cannot read the depth image (" + why + ")"));
+    throw SourceError(path + ": " +
+                      (why == "no such file" ? "depth image missing (no such file)"
+                                             : "cannot read the depth image (" + why + ")"));
   const fs::path p(path);
   fs::path cam = p.parent_path() / "camera.yaml";
   if (!fs::exists(cam, ec)) cam = p.parent_path().parent_path() / "camera.yaml";

@@ -52,7 +52,8 @@ class Reader {
     c.visit(*this);
   }
 
-  template <class S> void section(const char* name, const char*, S& s) {
+  template <class S>
+  void section(const char* name, const char*, S& s) {
     const std::string saved_prefix = prefix_;
     const YAML::Node sub = static_cast<const YAML::Node&>(stack_.back())[name];
     prefix_ = saved_prefix + name + ".";
@@ -72,7 +73,8 @@ class Reader {
   /// 1-based line of every key the file gives, by full name ("floor.tilt_min_deg").
   const std::map<std::string, int>& lines() const { return lines_; }
 
-  template <class T> void num(T& field, const char* key, Unit unit, double lo, double hi, const char*) {
+  template <class T>
+  void num(T& field, const char* key, Unit unit, double lo, double hi, const char*) {
     const YAML::Node n = static_cast<const YAML::Node&>(stack_.back())[key];
     const std::string full = prefix_ + key;
     if (!present(n, full)) return;
@@ -88,8 +90,9 @@ class Reader {
       fail(n, full, "expected a whole number, found '" + n.Scalar() + "'");
     if (v < lo || v > hi) {
       std::string u = unit_name(unit);
-      fail(n, full, "value " + n.Scalar() + " is out of range [" + fmt_num(lo) + ", " + fmt_num(hi) + "]" +
-                        (u.empty() ? "" : " " + u));
+      fail(n, full,
+           "value " + n.Scalar() + " is out of range [" + fmt_num(lo) + ", " + fmt_num(hi) + "]" +
+               (u.empty() ? "" : " " + u));
     }
     if (std::is_integral<T>::value)
       field = static_cast<T>(std::llround(v));
@@ -103,9 +106,12 @@ class Reader {
     if (!present(n, full)) return;
     if (!n.IsScalar()) fail(n, full, "expected true or false, found a " + kind(n));
     const std::string s = n.Scalar();
-    if (s == "true" || s == "yes" || s == "on") field = true;
-    else if (s == "false" || s == "no" || s == "off") field = false;
-    else fail(n, full, "expected true or false, found '" + s + "'");
+    if (s == "true" || s == "yes" || s == "on")
+      field = true;
+    else if (s == "false" || s == "no" || s == "off")
+      field = false;
+    else
+      fail(n, full, "expected true or false, found '" + s + "'");
   }
 
   void text(std::string& field, const char* key, std::initializer_list<const char*> allowed, const char*) {
@@ -165,19 +171,27 @@ class Reader {
 
   struct KeyLister {  // top-level: section names
     std::set<std::string>& out;
-    template <class T> void num(T&, const char*, Unit, double, double, const char*) {}
+    template <class T>
+    void num(T&, const char*, Unit, double, double, const char*) {}
     void flag(bool&, const char*, const char*) {}
     void text(std::string&, const char*, std::initializer_list<const char*>, const char*) {}
-    template <class S> void section(const char* name, const char*, S&) { out.insert(name); }
+    template <class S>
+    void section(const char* name, const char*, S&) {
+      out.insert(name);
+    }
   };
   struct SectionKeyLister {  // keys of one section
     std::string want;
     std::set<std::string>& out;
     bool inside = false;
-    template <class T> void num(T&, const char* k, Unit, double, double, const char*) { add(k); }
+    template <class T>
+    void num(T&, const char* k, Unit, double, double, const char*) {
+      add(k);
+    }
     void flag(bool&, const char* k, const char*) { add(k); }
     void text(std::string&, const char* k, std::initializer_list<const char*>, const char*) { add(k); }
-    template <class S> void section(const char* name, const char*, S& s) {
+    template <class S>
+    void section(const char* name, const char*, S& s) {
       inside = want == name;
       s.visit(*this);
       inside = false;
@@ -197,18 +211,21 @@ class Reader {
 class Writer {
  public:
   std::ostringstream os;
-  template <class S> void section(const char* name, const char* doc, S& s) {
+  template <class S>
+  void section(const char* name, const char* doc, S& s) {
     os << "\n# " << doc << "\n" << name << ":\n";
     s.visit(*this);
   }
-  template <class T> void num(T& f, const char* key, Unit unit, double lo, double hi, const char* doc) {
+  template <class T>
+  void num(T& f, const char* key, Unit unit, double lo, double hi, const char* doc) {
     double v = static_cast<double>(f);
     if (!std::is_integral<T>::value) v /= unit_to_si(unit);
     std::ostringstream val;
     val.precision(6);
     val << v;
     std::string u = unit_name(unit);
-    line(key, val.str(), std::string(doc) + " [" + fmt_num(lo) + ".." + fmt_num(hi) + (u.empty() ? "" : " " + u) + "]");
+    line(key, val.str(),
+         std::string(doc) + " [" + fmt_num(lo) + ".." + fmt_num(hi) + (u.empty() ? "" : " " + u) + "]");
   }
   void flag(bool& f, const char* key, const char* doc) { line(key, f ? "true" : "false", doc); }
   void text(std::string& f, const char* key, std::initializer_list<const char*> allowed, const char* doc) {

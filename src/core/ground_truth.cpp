@@ -4,18 +4,23 @@ namespace stairguide {
 
 const char* to_string(StairKind k) {
   switch (k) {
-    case StairKind::kNone: return "none";
-    case StairKind::kAscending: return "ascending";
-    case StairKind::kDescending: return "descending";
-    case StairKind::kSingleStep: return "single_step";
-    case StairKind::kCurb: return "curb";
+    case StairKind::kNone:
+      return "none";
+    case StairKind::kAscending:
+      return "ascending";
+    case StairKind::kDescending:
+      return "descending";
+    case StairKind::kSingleStep:
+      return "single_step";
+    case StairKind::kCurb:
+      return "curb";
   }
   return "none";
 }
 
 bool parse_stair_kind(const std::string& s, StairKind& out) {
-  for (StairKind k : {StairKind::kNone, StairKind::kAscending, StairKind::kDescending,
-                      StairKind::kSingleStep, StairKind::kCurb}) {
+  for (StairKind k : {StairKind::kNone, StairKind::kAscending, StairKind::kDescending, StairKind::kSingleStep,
+                      StairKind::kCurb}) {
     if (s == to_string(k)) {
       out = k;
       return true;

@@ -16,7 +16,8 @@ bool descent_in_view(const FrameTruth& t) {
   return false;
 }
 
-void add_to(DropEvalSummary& s, const DropSummary& told, const FrameTruth& truth, float near_m, bool floor_found) {
+void add_to(DropEvalSummary& s, const DropSummary& told, const FrameTruth& truth, float near_m,
+            bool floor_found) {
   ++s.frames;
   const bool yes = told.detected;
   if (truth.drop_in_view && truth.drop_distance_m <= near_m) {
@@ -46,26 +47,31 @@ void add_to(DropEvalSummary& s, const DropSummary& told, const FrameTruth& truth
 std::string summary_json(const DropEvalSummary& s) {
   auto n = [](double v) { return json_number(v); };
   return "{\"frames\": " + n(s.frames) + ", \"near\": " + n(s.near) + ", \"near_told\": " + n(s.near_told) +
-         ", \"near_rate\": " + n(s.near_rate()) + ", \"near_no_floor\": " + n(s.near_no_floor) + ", \"far\": " + n(s.far) + ", \"far_told\": " + n(s.far_told) +
-         ", \"none\": " + n(s.none) + ", \"none_told\": " + n(s.none_told) + ", \"hidden\": " + n(s.hidden) +
+         ", \"near_rate\": " + n(s.near_rate()) + ", \"near_no_floor\": " + n(s.near_no_floor) +
+         ", \"far\": " + n(s.far) + ", \"far_told\": " + n(s.far_told) + ", \"none\": " + n(s.none) +
+         ", \"none_told\": " + n(s.none_told) + ", \"hidden\": " + n(s.hidden) +
          ", \"hidden_told\": " + n(s.hidden_told) + ", \"descent\": " + n(s.descent) +
          ", \"descent_told\": " + n(s.descent_told) + ", \"descent_by_stairs\": " + n(s.descent_by_stairs) +
-         ", \"distance_err_mean_m\": " + n(s.distance.mean()) + ", \"distance_err_sigma_m\": " + n(s.distance.sigma()) +
+         ", \"distance_err_mean_m\": " + n(s.distance.mean()) +
+         ", \"distance_err_sigma_m\": " + n(s.distance.sigma()) +
          ", \"bearing_err_mean_abs_deg\": " + n(s.bearing_deg.mean_abs()) + "}";
 }
 
 std::string line(const std::string& name, const DropEvalSummary& s) {
   char b[320];
-  std::snprintf(b, sizeof b, "%-28s %6d  %4d/%-4d %6.1f%% %3d  %4d/%-4d  %4d/%-4d  %4d/%-4d (%d by stairs)  %+6.2f %5.2f  %5.1f\n",
-                name.c_str(), s.frames, s.near_told, s.near, 100.0 * s.near_rate(), s.near_no_floor, s.far_told, s.far, s.none_told,
-                s.none, s.descent_told, s.descent, s.descent_by_stairs, s.distance.mean(), s.distance.sigma(),
-                s.bearing_deg.mean_abs());
+  std::snprintf(
+      b, sizeof b,
+      "%-28s %6d  %4d/%-4d %6.1f%% %3d  %4d/%-4d  %4d/%-4d  %4d/%-4d (%d by stairs)  %+6.2f %5.2f  %5.1f\n",
+      name.c_str(), s.frames, s.near_told, s.near, 100.0 * s.near_rate(), s.near_no_floor, s.far_told, s.far,
+      s.none_told, s.none, s.descent_told, s.descent, s.descent_by_stairs, s.distance.mean(),
+      s.distance.sigma(), s.bearing_deg.mean_abs());
   return b;
 }
 
 }  // namespace
 
-void DropEvalTable::add(const DropSummary& told, const FrameTruth& truth, const std::string& scene, bool floor_found) {
+void DropEvalTable::add(const DropSummary& told, const FrameTruth& truth, const std::string& scene,
+                        bool floor_found) {
   add_to(all, told, truth, near_m, floor_found);
   add_to(by_scene[scene], told, truth, near_m, floor_found);
 }
@@ -85,11 +91,12 @@ std::string DropEvalTable::to_json() const {
 std::string DropEvalTable::to_text() const {
   char head[400];
   std::snprintf(head, sizeof head,
-                "\ndrops: told / frames (near: edge in view within %.1f m, nf: of its misses, no floor found; none: no drop "
+                "\ndrops: told / frames (near: edge in view within %.1f m, nf: of its misses, no floor "
+                "found; none: no drop "
                 "nor descent in view)\n"
                 "%-28s %6s  %-9s %7s %3s  %-9s  %-9s  %-9s                %6s %5s  %5s\n",
-                static_cast<double>(near_m), "scene", "frames", "near", "rate", "nf", "far", "none", "descent", "d_err",
-                "sd", "b_err");
+                static_cast<double>(near_m), "scene", "frames", "near", "rate", "nf", "far", "none",
+                "descent", "d_err", "sd", "b_err");
   std::string o = head;
   for (const auto& [k, v] : by_scene) o += line(k, v);
   return o + line("all", all);

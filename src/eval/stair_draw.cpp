@@ -24,7 +24,8 @@ void segment(cv::Mat& img, const CameraIntrinsics& K, const Eigen::Vector3f& a, 
 }
 
 cv::Scalar level_colour(int k) {
-  static const cv::Scalar c[] = {{255, 80, 0}, {0, 200, 0}, {0, 0, 255}, {255, 0, 255}, {0, 220, 255}, {255, 255, 0}};
+  static const cv::Scalar c[] = {{255, 80, 0},  {0, 200, 0},   {0, 0, 255},
+                                 {255, 0, 255}, {0, 220, 255}, {255, 255, 0}};
   return c[static_cast<std::size_t>(k) % 6];
 }
 
@@ -37,7 +38,8 @@ void draw_legend(cv::Mat& img, int levels) {
   cv::rectangle(img, box, {255, 255, 255}, cv::FILLED);
   cv::rectangle(img, box, {0, 0, 0}, 1);
   auto label = [&](int row, const char* s) {
-    cv::putText(img, s, {box.x + 60, box.y + 16 + 18 * row}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {0, 0, 0}, 1, cv::LINE_AA);
+    cv::putText(img, s, {box.x + 60, box.y + 16 + 18 * row}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {0, 0, 0}, 1,
+                cv::LINE_AA);
   };
   int row = 0;
   if (n > 0) {
@@ -86,7 +88,8 @@ void draw_stair_model(cv::Mat& img, const CameraIntrinsics& K, const StairResult
   // frame: x along the edge, y up, z into the staircase).
   const Pose& T = r.T_camera_stair;
   const float hw = 0.5f * r.width_m;
-  const int dir = r.kind == StairKind::kDescending || (r.level_data.size() > 1 && r.level_data[1].height < 0.f) ? -1 : 1;
+  const int dir =
+      r.kind == StairKind::kDescending || (r.level_data.size() > 1 && r.level_data[1].height < 0.f) ? -1 : 1;
   const float tread = r.tread_m > 0.f ? r.tread_m : 0.3f;
   auto S = [&](float x, float y, float z) { return Eigen::Vector3f(T * Eigen::Vector3f(x, y, z)); };
   for (int k = 1; k <= r.levels; ++k) {

@@ -12,11 +12,16 @@ namespace stairguide {
 
 const char* to_string(EvalOutcome o) {
   switch (o) {
-    case EvalOutcome::kTP: return "TP";
-    case EvalOutcome::kFP: return "FP";
-    case EvalOutcome::kTN: return "TN";
-    case EvalOutcome::kFN: return "FN";
-    case EvalOutcome::kSkipped: return "skipped";
+    case EvalOutcome::kTP:
+      return "TP";
+    case EvalOutcome::kFP:
+      return "FP";
+    case EvalOutcome::kTN:
+      return "TN";
+    case EvalOutcome::kFN:
+      return "FN";
+    case EvalOutcome::kSkipped:
+      return "skipped";
   }
   return "?";
 }
@@ -49,21 +54,27 @@ const char* kind_label(StairKind kind, bool down) {
 
 static const char* kind_class(StairKind kind, bool down) {
   switch (kind) {
-    case StairKind::kAscending: return "flight_up";
-    case StairKind::kDescending: return "flight_down";
-    case StairKind::kSingleStep: return "one_step_up";
-    case StairKind::kCurb: return down ? "one_step_down" : "one_step_up";
-    default: return "none";
+    case StairKind::kAscending:
+      return "flight_up";
+    case StairKind::kDescending:
+      return "flight_down";
+    case StairKind::kSingleStep:
+      return "one_step_up";
+    case StairKind::kCurb:
+      return down ? "one_step_down" : "one_step_up";
+    default:
+      return "none";
   }
 }
 
 const char* StairFrameEval::truth_label() const { return kind_label(truth_kind, truth_down); }
-const char* StairFrameEval::predicted_label() const { return kind_label(predicted_kind, predicted_direction < 0); }
-bool StairFrameEval::kind_exact() const {
-  return std::string(truth_label()) == predicted_label();
+const char* StairFrameEval::predicted_label() const {
+  return kind_label(predicted_kind, predicted_direction < 0);
 }
+bool StairFrameEval::kind_exact() const { return std::string(truth_label()) == predicted_label(); }
 bool StairFrameEval::kind_ok() const {
-  return std::string(kind_class(truth_kind, truth_down)) == kind_class(predicted_kind, predicted_direction < 0);
+  return std::string(kind_class(truth_kind, truth_down)) ==
+         kind_class(predicted_kind, predicted_direction < 0);
 }
 
 StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, const StairEvalOptions& opt) {
@@ -97,7 +108,8 @@ StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, c
     for (const auto& s : f.stairs) {
       if (!visible(s)) continue;
       const float d = opt.ignore_pose ? 0.f
-                                      : line_distance(o, s.T_camera_stair.translation(), s.T_camera_stair.linear().col(0));
+                                      : line_distance(o, s.T_camera_stair.translation(),
+                                                      s.T_camera_stair.linear().col(0));
       if (d > opt.match_distance) continue;
       // At the right edge but the wrong way (a curb down reported as a step up): no match, and
       // counted apart, since it is the answer that makes someone fall.
@@ -146,7 +158,8 @@ StairFrameEval evaluate_stair_frame(const StairResult& r, const FrameTruth& f, c
     e.has_riser = true;
     e.riser_err = r.riser_m - t.riser_m;
   }
-  if ((t.kind == StairKind::kAscending || t.kind == StairKind::kDescending) && r.levels >= 2 && r.tread_m > 0.f) {
+  if ((t.kind == StairKind::kAscending || t.kind == StairKind::kDescending) && r.levels >= 2 &&
+      r.tread_m > 0.f) {
     e.has_tread = true;
     e.tread_err = r.tread_m - t.tread_m;
   }
@@ -184,11 +197,20 @@ double ErrorStats::sigma() const {
 void EvalSummary::add(const StairFrameEval& e) {
   ++frames;
   switch (e.outcome) {
-    case EvalOutcome::kTP: ++tp; break;
-    case EvalOutcome::kTN: ++tn; break;
-    case EvalOutcome::kFN: ++fn; break;
-    case EvalOutcome::kFP: break;
-    case EvalOutcome::kSkipped: ++skipped; break;
+    case EvalOutcome::kTP:
+      ++tp;
+      break;
+    case EvalOutcome::kTN:
+      ++tn;
+      break;
+    case EvalOutcome::kFN:
+      ++fn;
+      break;
+    case EvalOutcome::kFP:
+      break;
+    case EvalOutcome::kSkipped:
+      ++skipped;
+      break;
   }
   if (e.outcome == EvalOutcome::kFP || e.false_positive) ++fp;
   if (e.wrong_direction) ++wrong_direction;
@@ -308,13 +330,15 @@ std::string StairEvalTable::to_text() const {
     };
     char yaw[40] = "      -     ";
     if (s.yaw.n) std::snprintf(yaw, sizeof yaw, "%5.2f+-%-5.2f", s.yaw.mean_abs(), s.yaw.sigma());
-    std::snprintf(line, sizeof line, "%-30s %6d %5d %5d %5d %5d %5d %6.3f %6.3f %s %s %s %s %s %s\n", name.c_str(),
-                  s.frames, s.tp, s.fp, s.tn, s.fn, s.skipped, s.precision(), s.recall(), cm(s.riser).c_str(),
-                  cm(s.tread).c_str(), cm(s.width).c_str(), cm(s.edge_pos).c_str(), cm(s.edge_line).c_str(), yaw);
+    std::snprintf(line, sizeof line, "%-30s %6d %5d %5d %5d %5d %5d %6.3f %6.3f %s %s %s %s %s %s\n",
+                  name.c_str(), s.frames, s.tp, s.fp, s.tn, s.fn, s.skipped, s.precision(), s.recall(),
+                  cm(s.riser).c_str(), cm(s.tread).c_str(), cm(s.width).c_str(), cm(s.edge_pos).c_str(),
+                  cm(s.edge_line).c_str(), yaw);
     o += line;
   };
-  std::snprintf(line, sizeof line, "%-30s %6s %5s %5s %5s %5s %5s %6s %6s %-12s %-12s %-12s %-12s %-12s %-12s\n", "",
-                "frames", "TP", "FP", "TN", "FN", "skip", "prec", "recall", "riser cm", "tread cm", "width cm",
+  std::snprintf(line, sizeof line,
+                "%-30s %6s %5s %5s %5s %5s %5s %6s %6s %-12s %-12s %-12s %-12s %-12s %-12s\n", "", "frames",
+                "TP", "FP", "TN", "FN", "skip", "prec", "recall", "riser cm", "tread cm", "width cm",
                 "edge cm", "edgeline cm", "yaw deg");
   o += line;
   row("all", all);

@@ -56,7 +56,8 @@ AlsaAudioSink::Counters AlsaAudioSink::counters() const {
   return counters_;
 }
 
-AlsaAudioSink::Voice AlsaAudioSink::voice_of(const Utterance& u, const std::vector<std::string>& clips) const {
+AlsaAudioSink::Voice AlsaAudioSink::voice_of(const Utterance& u,
+                                             const std::vector<std::string>& clips) const {
   Voice v;
   v.id = u.id;
   v.priority = u.priority;
@@ -71,8 +72,8 @@ AlsaAudioSink::Voice AlsaAudioSink::voice_of(const Utterance& u, const std::vect
 }
 
 void AlsaAudioSink::enqueue_locked(Utterance u) {
-  const auto at = std::find_if(queue_.begin(), queue_.end(),
-                               [&](const Utterance& q) { return q.priority < u.priority; });
+  const auto at =
+      std::find_if(queue_.begin(), queue_.end(), [&](const Utterance& q) { return q.priority < u.priority; });
   queue_.insert(at, std::move(u));
   if (queue_.size() > opt_.max_queue) {
     queue_.pop_back();
@@ -181,8 +182,8 @@ bool AlsaAudioSink::open_device() {
   for (;;) {
     e = snd_pcm_open(&p, opt_.device.c_str(), SND_PCM_STREAM_PLAYBACK, SND_PCM_NONBLOCK);
     if (e < 0) break;
-    e = snd_pcm_set_params(p, SND_PCM_FORMAT_S16_LE, SND_PCM_ACCESS_RW_INTERLEAVED, static_cast<unsigned>(channels),
-                           kSoundRate, 1, opt_.latency_us);
+    e = snd_pcm_set_params(p, SND_PCM_FORMAT_S16_LE, SND_PCM_ACCESS_RW_INTERLEAVED,
+                           static_cast<unsigned>(channels), kSoundRate, 1, opt_.latency_us);
     if (e >= 0) break;
     snd_pcm_close(p);
     p = nullptr;
@@ -208,9 +209,10 @@ bool AlsaAudioSink::open_device() {
   counters_.device_open = true;
   counters_.channels = channels;
   if (ev_.info)
-    ev_.info("audio: ALSA device '" + opt_.device + "' open (16-bit " + (channels == 2 ? "stereo" : "mono") + " " +
-             std::to_string(kSoundRate) + " Hz" +
-             (opt_.stereo && channels == 1 ? ", the device refused two channels: cues are not panned" : "") + ")");
+    ev_.info("audio: ALSA device '" + opt_.device + "' open (16-bit " + (channels == 2 ? "stereo" : "mono") +
+             " " + std::to_string(kSoundRate) + " Hz" +
+             (opt_.stereo && channels == 1 ? ", the device refused two channels: cues are not panned" : "") +
+             ")");
   return true;
 }
 
@@ -247,8 +249,9 @@ void AlsaAudioSink::render_locked(std::vector<std::int16_t>& out, std::size_t fr
     v.pos += n;
   };
   for (auto& v : mix_) add(v, earcons, true);
-  mix_.erase(std::remove_if(mix_.begin(), mix_.end(), [](const Voice& v) { return v.pos >= v.samples.size(); }),
-             mix_.end());
+  mix_.erase(
+      std::remove_if(mix_.begin(), mix_.end(), [](const Voice& v) { return v.pos >= v.samples.size(); }),
+      mix_.end());
   if (!speech_.empty()) {
     add(speech_[0], speech, false);
     if (speech_[0].pos >= speech_[0].samples.size()) speech_.clear();
@@ -316,9 +319,11 @@ void AlsaAudioSink::run() {
     }
     // Never more than ahead_s ahead of the device: the null and file PCMs take samples at once,
     // a card holds up to its buffer; either way a new cue goes into the next chunk.
-    const double ahead = static_cast<double>(written) / kSoundRate - std::chrono::duration<double>(now - t0).count();
+    const double ahead =
+        static_cast<double>(written) / kSoundRate - std::chrono::duration<double>(now - t0).count();
     if (ahead > opt_.ahead_s) {
-      cv_.wait_for(lk, std::chrono::duration<double>(std::min(ahead - opt_.ahead_s, 0.02)), [&] { return stop_; });
+      cv_.wait_for(lk, std::chrono::duration<double>(std::min(ahead - opt_.ahead_s, 0.02)),
+                   [&] { return stop_; });
       continue;
     }
     if (ahead < -1.0) {
@@ -337,8 +342,8 @@ void AlsaAudioSink::run() {
     std::size_t off = 0;
     bool failed = false;
     while (off < opt_.chunk_frames) {
-      const snd_pcm_sframes_t r = snd_pcm_writei(pcm, buf.data() + off * static_cast<std::size_t>(ch),
-                                                 opt_.chunk_frames - off);
+      const snd_pcm_sframes_t r =
+          snd_pcm_writei(pcm, buf.data() + off * static_cast<std::size_t>(ch), opt_.chunk_frames - off);
       if (r == -EAGAIN) {
         snd_pcm_wait(pcm, 50);
         continue;

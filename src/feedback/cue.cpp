@@ -316,12 +316,14 @@ std::vector<std::string> clips_for(const CueEvent& e) {
 
 const std::vector<std::string>& all_clip_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {
-        "ready",     "camera_lost", "camera_back", "cannot_see", "stairs_up", "stairs_down",   "step_up",
-        "step_down", "curb_up",     "curb_down",   "first_step", "last_step", "end_of_stairs", "steps_left",
-        "metre",     "metres",      "oclock",      "tick",       "up",        "down",          "warning",
-        "approach", "battery_low", "battery_critical", "slow",
-        "no_stairs", "muted", "unmuted", "quiet", "normal", "verbose", "drop_ahead"};
+    std::vector<std::string> n = {"ready",         "camera_lost", "camera_back", "cannot_see",
+                                  "stairs_up",     "stairs_down", "step_up",     "step_down",
+                                  "curb_up",       "curb_down",   "first_step",  "last_step",
+                                  "end_of_stairs", "steps_left",  "metre",       "metres",
+                                  "oclock",        "tick",        "up",          "down",
+                                  "warning",       "approach",    "battery_low", "battery_critical",
+                                  "slow",          "no_stairs",   "muted",       "unmuted",
+                                  "quiet",         "normal",      "verbose",     "drop_ahead"};
     for (int i = 1; i <= kMaxNumber; ++i) n.push_back(number_clip(i));
     return n;
   }();

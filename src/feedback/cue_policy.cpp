@@ -25,7 +25,8 @@ int clock_position(float bearing_rad) {
   return c == 0 ? 12 : c;
 }
 
-CuePolicy::CuePolicy(const FeedbackConfig& config) : cfg_(config), verbosity_(parse_verbosity(config.verbosity)) {
+CuePolicy::CuePolicy(const FeedbackConfig& config)
+    : cfg_(config), verbosity_(parse_verbosity(config.verbosity)) {
   std::fill(std::begin(last_t_), std::end(last_t_), kNever);
 }
 
@@ -75,7 +76,7 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kCameraBack:
     case Cue::kReady:
     case Cue::kCount:
-    case Cue::kApproach:  // its own rhythm (approach_cues)
+    case Cue::kApproach:    // its own rhythm (approach_cues)
     case Cue::kBatteryLow:  // their own repeats (battery(), step())
     case Cue::kBatteryCritical:
     case Cue::kSlow:
@@ -142,7 +143,7 @@ void CuePolicy::approach_cues(const Sighting& s, const DropSummary& drop, const 
 }
 
 void CuePolicy::approach_beat(float d, float bearing, double t, std::vector<CueEvent>& out) {
-  constexpr float kNearer = 0.15f;      // m the wearer must come nearer to count as walking on
+  constexpr float kNearer = 0.15f;       // m the wearer must come nearer to count as walking on
   constexpr float kRangeMargin = 0.25f;  // m beyond the range before a beeping approach stops
   Approach& a = approach_;
   const bool ahead = !std::isfinite(bearing) || std::fabs(bearing) <= cfg_.approach_cone;
@@ -349,7 +350,8 @@ std::vector<CueEvent> CuePolicy::step(const CueInput& in) {
     blind_since_ = -1.0;
     slow_since_ = -1.0;
     approach_ = Approach{};
-    if (mute_until_ >= 0.0) mute_until_ = t + std::max(0.0, mute_until_ - last_frame_t_);  // what was left of it
+    if (mute_until_ >= 0.0)
+      mute_until_ = t + std::max(0.0, mute_until_ - last_frame_t_);  // what was left of it
     drop_ = DropHold{};
   }
   last_frame_t_ = t;

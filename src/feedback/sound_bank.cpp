@@ -77,7 +77,8 @@ SoundSet sound_set_for(const std::string& sounds_dir, const std::string& languag
     set.speech_dir = dir;
     set.language = language;
   } else {
-    set.problem = "no sounds for language '" + language + "' (feedback.language): " + dir + " is not a folder";
+    set.problem =
+        "no sounds for language '" + language + "' (feedback.language): " + dir + " is not a folder";
   }
   return set;
 }

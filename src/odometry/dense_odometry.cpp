@@ -154,8 +154,7 @@ DenseOdometry::Impl::Solve DenseOdometry::Impl::estimate(const Pyramid& cur, con
       D.linear() = rot_exp(xi.tail<3>());
       D.translation() = xi.head<3>();
       G = G * D;
-      if (xi.head<3>().norm() < cfg.min_update_translation &&
-          xi.tail<3>().norm() < cfg.min_update_rotation) {
+      if (xi.head<3>().norm() < cfg.min_update_translation && xi.tail<3>().norm() < cfg.min_update_rotation) {
         level_converged = true;
         break;
       }

@@ -101,8 +101,7 @@ void DenseOdometry::Impl::build_points(const Pyramid& P, int l, PointList& L) co
       // compression artefacts than a bare central difference.
       const float gIx =
           0.125f * (2.f * (Ir[x + 1] - Ir[x - 1]) + (Iu[x + 1] - Iu[x - 1]) + (Id[x + 1] - Id[x - 1]));
-      const float gIy =
-          0.125f * (2.f * (Id[x] - Iu[x]) + (Id[x - 1] - Iu[x - 1]) + (Id[x + 1] - Iu[x + 1]));
+      const float gIy = 0.125f * (2.f * (Id[x] - Iu[x]) + (Id[x - 1] - Iu[x - 1]) + (Id[x + 1] - Iu[x + 1]));
       const float z = 1.f / w;
       const float X = (static_cast<float>(x) - k.cx) * ifx * z;
       const float Y = (static_cast<float>(y) - k.cy) * ify * z;

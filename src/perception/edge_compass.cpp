@@ -130,7 +130,8 @@ EdgeCompassResult EdgeCompass::estimate(const cv::Mat& gray, const CameraIntrins
   float best_sum = -1.f;
   for (int i = 0; i < kBins; ++i) {
     float s = 0.f;
-    for (int k = -kWin; k <= kWin; ++k) s += hist_[static_cast<std::size_t>(((i + k) % kBins + kBins) % kBins)];
+    for (int k = -kWin; k <= kWin; ++k)
+      s += hist_[static_cast<std::size_t>(((i + k) % kBins + kBins) % kBins)];
     if (s > best_sum) best_sum = s, best = i;
   }
   float yaw = -0.25f * kPi + (static_cast<float>(best) + 0.5f) * kQuarter / kBins;

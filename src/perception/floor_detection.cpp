@@ -46,10 +46,12 @@ FloorDetector::Reach FloorDetector::reach(const PlaneRegion& r) {
   // keep this linear pass and the selection cheap on a floor of tens of thousands of points.
   const std::size_t step = r.points.size() > 400 ? std::max<std::size_t>(2, r.points.size() / 4000) : 1;
   near_buf_.clear();
-  for (std::size_t k = 0; k < r.points.size(); k += step) near_buf_.push_back(foot_distance(r.normal, r.points[k]));
+  for (std::size_t k = 0; k < r.points.size(); k += step)
+    near_buf_.push_back(foot_distance(r.normal, r.points[k]));
   out.distance = percentile(near_buf_, 20);
   near_buf_.clear();
-  for (std::size_t k = 0; k < r.points.size(); k += step) near_buf_.push_back(nadir_tan(r.normal, r.points[k]));
+  for (std::size_t k = 0; k < r.points.size(); k += step)
+    near_buf_.push_back(nadir_tan(r.normal, r.points[k]));
   out.angle = std::atan(percentile(near_buf_, 20));
   return out;
 }
@@ -134,9 +136,8 @@ bool FloorDetector::drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame
   return columns >= 8 && dropped * 2 >= columns;
 }
 
-
-FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame, float height_lo,
-                                    float height_hi, float tilt_lo, float tilt_hi) {
+FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame,
+                                    float height_lo, float height_hi, float tilt_lo, float tilt_hi) {
   FloorEstimate est;
   clear_height_.reset();
   refused_as_tread_ = false;
@@ -160,7 +161,8 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
   }
   if (cand.empty()) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "no plane with a chest camera's orientation and height (%.2f-%.2f m below it%s)",
+    std::snprintf(buf, sizeof buf,
+                  "no plane with a chest camera's orientation and height (%.2f-%.2f m below it%s)",
                   static_cast<double>(height_lo), static_cast<double>(height_hi),
                   rig_height_ && !probe_ ? ": the user's camera height, held" : "");
     est.why = buf;
@@ -174,7 +176,8 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
     cand.erase(std::remove_if(cand.begin(), cand.end(),
                               [&](int i) {
                                 return regions[i].normal.dot(prev->normal) < cos_jump ||
-                                       std::fabs(regions[i].offset - prev->offset) > cfg_.track_max_height_jump;
+                                       std::fabs(regions[i].offset - prev->offset) >
+                                           cfg_.track_max_height_jump;
                               }),
                cand.end());
     if (cand.empty()) {
@@ -186,9 +189,10 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
     // user, not of the place: on a staircase the tread underfoot is at the remembered height while
     // the treads and the landing below are a riser or more lower. A plane that much lower is
     // never the floor; with the tread underfoot out of view, no floor is reported.
-    cand.erase(std::remove_if(cand.begin(), cand.end(),
-                              [&](int i) { return regions[i].offset - prev->offset > cfg_.track_max_height_jump; }),
-               cand.end());
+    cand.erase(
+        std::remove_if(cand.begin(), cand.end(),
+                       [&](int i) { return regions[i].offset - prev->offset > cfg_.track_max_height_jump; }),
+        cand.end());
     if (cand.empty()) {
       est.why = "the planes in view are a riser or more below the remembered floor (treads below the user)";
       return est;
@@ -209,9 +213,11 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
     // The tracked floor has been told from the steps already: no ambiguity left.
     stack_below_ = false;
     const bool stair = clear && !tracked &&
-                       (stair_from_view_edge(regions, chosen, near, frame.depth.cols) || middle_of_stack(regions, chosen, near));
+                       (stair_from_view_edge(regions, chosen, near, frame.depth.cols) ||
+                        middle_of_stack(regions, chosen, near));
     // Cold, passing every other check: the user may stand on a level above it at the view's edge.
-    if (clear && !stair && !tracked && level_above_underfoot(regions, chosen, frame.depth.cols, frame.depth.rows)) {
+    if (clear && !stair && !tracked &&
+        level_above_underfoot(regions, chosen, frame.depth.cols, frame.depth.rows)) {
       est.level_region = chosen;
       est.why = "the user may stand on the level above, seen at the view's edge";
       refused_as_tread_ = true;
@@ -232,8 +238,10 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
       est.tracked = true;
       break;
     }
-    if (!clear) ++rejected_below;
-    else ++rejected_stair;
+    if (!clear)
+      ++rejected_below;
+    else
+      ++rejected_stair;
     if (rejected_below + rejected_stair == 1) est.level_region = chosen;
     const Eigen::Vector3f n0 = f.normal;
     const float d0 = f.offset;
@@ -256,8 +264,9 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
     else if (rejected_stair == 0)
       est.why = "every floor-like plane has something below it nearer the user (a step, a seat)";
     else if (rejected_below == 0)
-      est.why = "the floor-like plane may be a tread: a step rises right after where the view starts, or it lies a "
-                "riser below a bigger level with a drop ahead";
+      est.why =
+          "the floor-like plane may be a tread: a step rises right after where the view starts, or it lies a "
+          "riser below a bigger level with a drop ahead";
     else
       est.why = "the floor-like planes have something below them nearer the user, or may be a tread";
     return est;
@@ -301,11 +310,12 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
     if (prev_ && lost_frames_ < cfg_.track_hold_frames)
       hi = std::max(hi, std::min(prev_->offset + cfg_.track_max_height_jump, cfg_.usual_height_max));
     const TiltBand tilt = rig_tilt_band();
-    est = select(regions, frame, std::max(cfg_.height_min, lo), std::min(cfg_.height_max, hi), tilt.lo, tilt.hi);
+    est = select(regions, frame, std::max(cfg_.height_min, lo), std::min(cfg_.height_max, hi), tilt.lo,
+                 tilt.hi);
   } else {
     est = select(regions, frame, std::max(cfg_.height_min, cfg_.usual_height_min),
-                 std::min(cfg_.height_max, cfg_.usual_height_max), std::max(cfg_.tilt_min, cfg_.usual_tilt_min),
-                 std::min(cfg_.tilt_max, cfg_.usual_tilt_max));
+                 std::min(cfg_.height_max, cfg_.usual_height_max),
+                 std::max(cfg_.tilt_min, cfg_.usual_tilt_min), std::min(cfg_.tilt_max, cfg_.usual_tilt_max));
     if (!est.found && !refused_as_tread_) {
       // Outside the usual band one view is no evidence (a worktop or a bed filling a cold view
       // looks like the floor of a waist rig): rig_learn_frames clear views agreeing on the height
@@ -326,8 +336,10 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
       FloorEstimate wide = select(regions, frame, wide_lo, wide_hi, wide_tilt.lo, wide_tilt.hi);
       if (wide.found && clear_height_ && rig_height_) {
         // Held in the band: outside it only a floor near the held height.
-        if (std::fabs(wide.offset - *rig_height_) <= tol) est = wide;
-        else clear_height_.reset();
+        if (std::fabs(wide.offset - *rig_height_) <= tol)
+          est = wide;
+        else
+          clear_height_.reset();
       } else if (wide.found && clear_height_) {
         learn(*clear_height_, wide.tilt);
         if (rig_height_) {
@@ -337,15 +349,17 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
           est = FloorEstimate{};
           est.level_region = wide.region;
           char buf[220];
-          std::snprintf(buf, sizeof buf,
-                        "a floor-like plane %.2f m below the camera, outside the usual chest rig: %d of %d clear views "
-                        "to establish the camera height",
-                        static_cast<double>(wide.offset), std::min(have, cfg_.rig_learn_frames), cfg_.rig_learn_frames);
+          std::snprintf(
+              buf, sizeof buf,
+              "a floor-like plane %.2f m below the camera, outside the usual chest rig: %d of %d clear views "
+              "to establish the camera height",
+              static_cast<double>(wide.offset), std::min(have, cfg_.rig_learn_frames), cfg_.rig_learn_frames);
           est.why = buf;
           clear_height_.reset();
         }
       } else if (wide.found || wide.level_region >= 0) {
-        if (wide.found && !wide.tracked) wide.found = false, wide.why = "a floor-like plane outside the usual chest rig";
+        if (wide.found && !wide.tracked)
+          wide.found = false, wide.why = "a floor-like plane outside the usual chest rig";
         est = wide;
       }
     }
@@ -375,7 +389,8 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
   // no level lies in view between the camera and it (standing on a stair, or at its top, the treads
   // nearer the camera are in view; the wearer who sat down has no level nearer than the floor).
   probe_ = true;
-  const FloorEstimate cold = select(regions, frame, cfg_.height_min, cfg_.height_max, cfg_.tilt_min, cfg_.tilt_max);
+  const FloorEstimate cold =
+      select(regions, frame, cfg_.height_min, cfg_.height_max, cfg_.tilt_min, cfg_.tilt_max);
   probe_ = false;
   const std::optional<float> other = clear_height_;
   clear_height_.reset();
@@ -396,7 +411,8 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
       }
     }
   }
-  if (evidence && !relearn_.empty() && std::fabs(*other - relearn_.back().height) > cfg_.track_max_height_jump)
+  if (evidence && !relearn_.empty() &&
+      std::fabs(*other - relearn_.back().height) > cfg_.track_max_height_jump)
     relearn_.clear();
   if (evidence) {
     relearn_.push_back(RigView{*other, cold.tilt});
@@ -423,11 +439,12 @@ FloorEstimate FloorDetector::detect(const std::vector<PlaneRegion>& regions, con
   }
   if (evidence) {
     char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "a floor-like plane %.2f m below the camera, not the user's %.2f m (relearning the camera height: %d "
-                  "of %d frames)",
-                  static_cast<double>(*other), static_cast<double>(*rig_height_), static_cast<int>(relearn_.size()),
-                  cfg_.rig_relearn_frames);
+    std::snprintf(
+        buf, sizeof buf,
+        "a floor-like plane %.2f m below the camera, not the user's %.2f m (relearning the camera height: %d "
+        "of %d frames)",
+        static_cast<double>(*other), static_cast<double>(*rig_height_), static_cast<int>(relearn_.size()),
+        cfg_.rig_relearn_frames);
     est.why = buf;
   }
   return est;
@@ -514,7 +531,8 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
     // it is the plane nearest the camera's feet, not the biggest one. One pass per candidate
     // bins its footprint by window; the windows are then cumulative sums.
     const float step = std::max(cfg_.search_step, 1e-3f);
-    const int steps = std::max(1, static_cast<int>(std::ceil((cfg_.search_max - cfg_.search_start) / step)) + 1);
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil((cfg_.search_max - cfg_.search_start) / step)) + 1);
     window_area_.assign(cand.size() * static_cast<std::size_t>(steps), 0.f);
     for (std::size_t c = 0; c < cand.size(); ++c) {
       const PlaneRegion& r = regions[cand[c]];
@@ -576,4 +594,3 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
 }
 
 }  // namespace stairguide
-

@@ -15,7 +15,8 @@ namespace stairguide {
 
 using namespace floor_detail;
 
-FloorDetector::Span FloorDetector::span(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& axis) {
+FloorDetector::Span FloorDetector::span(const std::vector<Eigen::Vector3f>& pts,
+                                        const Eigen::Vector3f& axis) {
   // 0.5th and 99.5th percentiles: a region's extent along an axis, robust to stray points.
   near_buf_.clear();
   const std::size_t step = pts.size() > 4000 ? pts.size() / 4000 : 1;
@@ -26,7 +27,8 @@ FloorDetector::Span FloorDetector::span(const std::vector<Eigen::Vector3f>& pts,
   return out;
 }
 
-bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A) {
+bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, const PlaneRegion& C,
+                                   const PlaneRegion& A) {
   // C starts at the view's edge and A, one riser above it, looks like the next tread of a flight
   // with C its first tread (the floor under the user's feet out of view). C cannot be a tread of
   // that flight when what is seen of it alone contradicts it, in 3D, whatever the camera's tilt:
@@ -54,7 +56,8 @@ bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, cons
   const float cos_par = std::cos(cfg_.horizontal_tolerance);
   float beside = 0.f;
   for (const PlaneRegion& L : regions) {
-    if (L.points.empty() || L.normal.dot(C.normal) < cos_par || std::fabs(L.offset - C.offset) > cfg_.inlier_distance)
+    if (L.points.empty() || L.normal.dot(C.normal) < cos_par ||
+        std::fabs(L.offset - C.offset) > cfg_.inlier_distance)
       continue;
     const float per_point = L.area / static_cast<float>(L.points.size());
     for (const auto& q : L.points) {
@@ -67,12 +70,15 @@ bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, cons
 
   // Deeper than the treads ahead. B: the tread after A (one riser above it, starting beyond it,
   // in front of the same stretch of the flight).
-  auto rise_ok = [&](float rise) { return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max; };
+  auto rise_ok = [&](float rise) {
+    return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max;
+  };
   const float a_depth = a_d.hi - a_d.lo;
   bool agree = false;
   float going = a_depth;
   for (const PlaneRegion& B : regions) {
-    if (&B == &A || B.points.empty() || B.normal.dot(C.normal) < cos_par || !rise_ok(A.offset - B.offset)) continue;
+    if (&B == &A || B.points.empty() || B.normal.dot(C.normal) < cos_par || !rise_ok(A.offset - B.offset))
+      continue;
     const float t = side.dot(B.centroid);
     if (t < a_s.lo || t > a_s.hi) continue;
     const Span b_d = span(B.points, d);
@@ -96,7 +102,8 @@ bool FloorDetector::not_a_tread_of(const std::vector<PlaneRegion>& regions, cons
   return c_hi - c_lo > going + cfg_.floor_deeper_than_tread;
 }
 
-bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width) {
+bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near,
+                                         int width) {
   // A plane that starts at the bottom of the view (we cannot see what the user stands on) with
   // another plane one riser above or below it starting a tread's depth further: the first tread
   // of an ascending staircase filling the bottom of the view looks exactly like a floor with a
@@ -108,7 +115,8 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
   float lowest = 1e9f;
   const CameraIntrinsics& K = K_;
   auto ray = [&](float u, float v) {
-    lowest = std::min(lowest, nadir_tan(C.normal, Eigen::Vector3f((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f)));
+    lowest =
+        std::min(lowest, nadir_tan(C.normal, Eigen::Vector3f((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f)));
   };
   const float Wf = static_cast<float>(K.width - 1), Hf = static_cast<float>(K.height - 1);
   for (float u = 0.f; u <= Wf; u += 8.f) ray(u, 0.f), ray(u, Hf);
@@ -141,7 +149,8 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
     col_top_.assign(static_cast<std::size_t>(width), -1);
     for (int p : A.pixels) {
       const int u = p % width, v = p / width;
-      col_top_[static_cast<std::size_t>(u)] = std::max(col_top_[static_cast<std::size_t>(u)], v);  // A's lowest row
+      col_top_[static_cast<std::size_t>(u)] =
+          std::max(col_top_[static_cast<std::size_t>(u)], v);  // A's lowest row
     }
     std::size_t under = 0, seen = 0;
     for (std::size_t k = 0; k < C.pixels.size(); k += 4, ++seen) {  // a subsample is enough for a share
@@ -161,7 +170,8 @@ bool FloorDetector::stair_from_view_edge(const std::vector<PlaneRegion>& regions
   return false;
 }
 
-bool FloorDetector::tread_shaped(const std::vector<PlaneRegion>& regions, const PlaneRegion& C, const PlaneRegion& A) {
+bool FloorDetector::tread_shaped(const std::vector<PlaneRegion>& regions, const PlaneRegion& C,
+                                 const PlaneRegion& A) {
   // A must be clearly a tread (far wider than deep) for its axes to give the flight's directions.
   if (A.points.empty() || C.points.empty() || A.rect_length_minor <= 0.f ||
       A.rect_length_major < cfg_.tread_min_aspect * A.rect_length_minor)
@@ -176,7 +186,8 @@ bool FloorDetector::tread_shaped(const std::vector<PlaneRegion>& regions, const 
   constexpr float kWidthMargin = 0.05f;  // m, A's ends are cut by a few cm of noise and nosing shadow
   const float cos_par = std::cos(cfg_.horizontal_tolerance);
   for (const PlaneRegion& L : regions) {
-    if (L.points.empty() || L.normal.dot(C.normal) < cos_par || std::fabs(L.offset - C.offset) > cfg_.inlier_distance)
+    if (L.points.empty() || L.normal.dot(C.normal) < cos_par ||
+        std::fabs(L.offset - C.offset) > cfg_.inlier_distance)
       continue;
     const Span l_s = span(L.points, side);
     if (l_s.lo < a_s.lo - kWidthMargin || l_s.hi > a_s.hi + kWidthMargin) return false;
@@ -198,11 +209,14 @@ bool FloorDetector::middle_of_stack(const std::vector<PlaneRegion>& regions, int
   const PlaneRegion& C = regions[c];
   if (C.points.empty()) return false;
   const float cos_par = std::cos(cfg_.horizontal_tolerance);
-  auto rise_ok = [&](float rise) { return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max; };
+  auto rise_ok = [&](float rise) {
+    return rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max;
+  };
   bool above = false;
   for (const PlaneRegion& U : regions)
     // Normals face the camera: a plane above C is nearer the camera, its offset smaller.
-    if (!U.points.empty() && U.normal.dot(C.normal) >= cos_par && U.area >= C.area && rise_ok(C.offset - U.offset))
+    if (!U.points.empty() && U.normal.dot(C.normal) >= cos_par && U.area >= C.area &&
+        rise_ok(C.offset - U.offset))
       above = true;
   if (!above) return false;
   Eigen::Vector3f fwd = Eigen::Vector3f::UnitZ() - C.normal * C.normal.z();  // the camera's forward, levelled
@@ -225,11 +239,13 @@ bool FloorDetector::middle_of_stack(const std::vector<PlaneRegion>& regions, int
   return false;
 }
 
-bool FloorDetector::edge_end_at_border(const std::vector<Eigen::Vector2f>& edge, const Eigen::Vector2f& along, float t,
-                                       const Pose& T_floor_camera, float rise, int width, int height) const {
+bool FloorDetector::edge_end_at_border(const std::vector<Eigen::Vector2f>& edge, const Eigen::Vector2f& along,
+                                       float t, const Pose& T_floor_camera, float rise, int width,
+                                       int height) const {
   // The edge's point nearest position t along it, back in the image (it lies `rise` above the
   // floor frame's plane): within a few pixels of the view's border, or beyond it.
-  constexpr float kBorderPx = 16.f;  // the boundary band is a few cm wide: its ends reach this near the border
+  constexpr float kBorderPx =
+      16.f;  // the boundary band is a few cm wide: its ends reach this near the border
   if (edge.empty()) return false;
   Eigen::Vector2f q = edge.front();
   float best = std::numeric_limits<float>::max();
@@ -244,7 +260,8 @@ bool FloorDetector::edge_end_at_border(const std::vector<Eigen::Vector2f>& edge,
          v > static_cast<float>(height - 1) - kBorderPx;
 }
 
-bool FloorDetector::level_above_underfoot(const std::vector<PlaneRegion>& regions, int c, int width, int height) {
+bool FloorDetector::level_above_underfoot(const std::vector<PlaneRegion>& regions, int c, int width,
+                                          int height) {
   // Standing on a curb (or a step, a platform) and looking down at the road beyond it, the camera
   // may see the user's own level only as a strip along the view's bottom edge: too small for the
   // floor, while the big lower level passes every check (nothing lower lies nearer the feet, the
@@ -321,7 +338,8 @@ bool FloorDetector::level_above_underfoot(const std::vector<PlaneRegion>& region
     b.clear();
     for (const auto& q : u2) {
       const int gx = static_cast<int>((q.x() - x0) / cell), gz = static_cast<int>((q.y() - z0) / cell);
-      if (gx < 0 || gz < 0 || gx >= gw || gz >= gh || !grid_[static_cast<std::size_t>(gz) * gw + gx]) continue;
+      if (gx < 0 || gz < 0 || gx >= gw || gz >= gh || !grid_[static_cast<std::size_t>(gz) * gw + gx])
+        continue;
       b.push_back(q);
       mean += q;
     }

@@ -74,8 +74,8 @@ Eigen::Vector3f fit_upright_normal(const std::vector<Eigen::Vector3f>& pts, cons
 // clouds refused; on their far walls it refits 2 of 14 planes, both nearer the truth
 // (PerceptionRealData.FarWallsAtTheCutOffHeldUprightAreNoWorse).
 Eigen::Vector3f fit_upright_normal_clear_of_cutoff(const std::vector<Eigen::Vector3f>& pts,
-                                                   const Eigen::Vector3f& up, const Eigen::Vector3f& n_upright,
-                                                   float clear_depth) {
+                                                   const Eigen::Vector3f& up,
+                                                   const Eigen::Vector3f& n_upright, float clear_depth) {
   constexpr std::size_t kMinPoints = 30;
   Eigen::Vector3f n = n_upright;
   if (pts.size() < kMinPoints || !(clear_depth > 0.f)) return n;
@@ -126,7 +126,8 @@ float ManhattanHistogram::mode() const {
 
 ManhattanTracker::ManhattanTracker(const ManhattanConfig& config, float max_range, float depth_noise_coeff)
     : cfg_(config), max_range_(max_range) {
-  if (max_range_ > 0.f) clear_depth_ = max_range_ - 3.f * std::max(0.f, depth_noise_coeff) * max_range_ * max_range_;
+  if (max_range_ > 0.f)
+    clear_depth_ = max_range_ - 3.f * std::max(0.f, depth_noise_coeff) * max_range_ * max_range_;
 }
 
 ManhattanEstimate ManhattanTracker::confirm(const std::vector<Vote>& votes, float total_area,
@@ -409,8 +410,9 @@ ManhattanEstimate ManhattanTracker::solve(const std::vector<Vote>& votes, float 
   const float rbar = std::min(1.f, std::sqrt(sc * sc + ss * ss) / wsum);
   const float spread = 0.25f * std::sqrt(std::max(0.f, -2.f * std::log(std::max(rbar, 1e-6f))));
   if (!wide && (!parallel_pair || spread > cfg_.max_spread)) {
-    est.why = "no wide vertical plane, and the narrow ones are one, too narrow or disagree by degrees (no wall or "
-              "riser in view, or too little of one to trust)";
+    est.why =
+        "no wide vertical plane, and the narrow ones are one, too narrow or disagree by degrees (no wall or "
+        "riser in view, or too little of one to trust)";
     return est;
   }
   const float yaw = manhattan_keep_branch(wrap_quarter(0.25f * std::atan2(ss, sc)), prev_yaw_);

@@ -10,15 +10,24 @@ namespace stairguide {
 
 const char* to_string(RegionClass c) {
   switch (c) {
-    case RegionClass::kUnclassified: return "unclassified";
-    case RegionClass::kFloor: return "floor";
-    case RegionClass::kStepCandidate: return "step_candidate";
-    case RegionClass::kObstacle: return "obstacle";
-    case RegionClass::kVerticalLeft: return "vertical_left";
-    case RegionClass::kVerticalRight: return "vertical_right";
-    case RegionClass::kVerticalFront: return "vertical_front";
-    case RegionClass::kVertical: return "vertical";
-    case RegionClass::kOther: return "other";
+    case RegionClass::kUnclassified:
+      return "unclassified";
+    case RegionClass::kFloor:
+      return "floor";
+    case RegionClass::kStepCandidate:
+      return "step_candidate";
+    case RegionClass::kObstacle:
+      return "obstacle";
+    case RegionClass::kVerticalLeft:
+      return "vertical_left";
+    case RegionClass::kVerticalRight:
+      return "vertical_right";
+    case RegionClass::kVerticalFront:
+      return "vertical_front";
+    case RegionClass::kVertical:
+      return "vertical";
+    case RegionClass::kOther:
+      return "other";
   }
   return "unclassified";
 }
@@ -133,7 +142,8 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
       const PlaneRegion& level = out.regions[static_cast<std::size_t>(floor_est_.level_region)];
       manhattan(floor_pose_from_plane(level.normal, level.offset));
       out.manhattan_without_floor = out.manhattan_found;
-      if (!out.manhattan_found) out.manhattan_why = "no floor; about a floor-like plane's vertical: " + out.manhattan_why;
+      if (!out.manhattan_found)
+        out.manhattan_why = "no floor; about a floor-like plane's vertical: " + out.manhattan_why;
     } else {
       out.manhattan_why = "no floor";
     }
@@ -162,7 +172,8 @@ ManhattanSighting Perception::manhattan_sighting(const SceneResult& out, double 
   for (const PlaneRegion& r : out.regions) {
     const Eigen::Vector3f nf = R_fc * r.normal;
     if (std::fabs(nf.y()) > sin_tol || r.points.empty()) continue;
-    if (std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - out.manhattan_yaw)) > manhattan_cfg_.cluster_tolerance)
+    if (std::fabs(wrap_quarter(std::atan2(nf.x(), nf.z()) - out.manhattan_yaw)) >
+        manhattan_cfg_.cluster_tolerance)
       continue;
     const Eigen::Vector3f hz = up_c.cross(r.normal).normalized();
     float lo = hz.dot(r.points.front()), hi = lo;
@@ -174,7 +185,8 @@ ManhattanSighting Perception::manhattan_sighting(const SceneResult& out, double 
     weight += r.area * s * s;
   }
   sg.valid = true;
-  sg.k_camera = R_fc.transpose() * Eigen::Vector3f(std::sin(out.manhattan_yaw), 0.f, std::cos(out.manhattan_yaw));
+  sg.k_camera =
+      R_fc.transpose() * Eigen::Vector3f(std::sin(out.manhattan_yaw), 0.f, std::cos(out.manhattan_yaw));
   sg.weight = std::max(weight, 1e-6f);
   sg.timestamp = timestamp;
   return sg;
@@ -260,10 +272,11 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
       return;
     }
     char buf[160];
-    std::snprintf(buf, sizeof buf,
-                  "this view's planes made a frame %.1f deg off the one held in the world, and weigh less: kept "
-                  "the held one",
-                  off * 57.2957795f);
+    std::snprintf(
+        buf, sizeof buf,
+        "this view's planes made a frame %.1f deg off the one held in the world, and weigh less: kept "
+        "the held one",
+        off * 57.2957795f);
     out.manhattan_why = buf;
   }
   // k_M on the branch last reported, as ManhattanTracker keeps it for the frames it sees.
@@ -289,15 +302,20 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
 
 cv::Vec3b region_class_color(RegionClass c) {
   switch (c) {
-    case RegionClass::kFloor: return {0, 200, 0};
-    case RegionClass::kStepCandidate: return {255, 80, 0};
+    case RegionClass::kFloor:
+      return {0, 200, 0};
+    case RegionClass::kStepCandidate:
+      return {255, 80, 0};
     case RegionClass::kObstacle:
-    case RegionClass::kOther: return {0, 0, 230};
+    case RegionClass::kOther:
+      return {0, 0, 230};
     case RegionClass::kVerticalLeft:
     case RegionClass::kVerticalRight:
     case RegionClass::kVerticalFront:
-    case RegionClass::kVertical: return {0, 230, 255};
-    case RegionClass::kUnclassified: return {160, 160, 160};
+    case RegionClass::kVertical:
+      return {0, 230, 255};
+    case RegionClass::kUnclassified:
+      return {160, 160, 160};
   }
   return {160, 160, 160};
 }
@@ -317,7 +335,8 @@ cv::Mat draw_classification(const cv::Mat& base, const cv::Mat& depth, const Sce
       for (int u = 0; u < W; ++u) {
         const float z = depth.at<float>(v, u);
         const int g = z > 0.f ? std::max(30, std::min(255, static_cast<int>(255.f - 45.f * z))) : 0;
-        img.at<cv::Vec3b>(v, u) = cv::Vec3b(static_cast<uchar>(g), static_cast<uchar>(g), static_cast<uchar>(g));
+        img.at<cv::Vec3b>(v, u) =
+            cv::Vec3b(static_cast<uchar>(g), static_cast<uchar>(g), static_cast<uchar>(g));
       }
   }
   if (static_cast<int>(labels.size()) != H * W) return img;
@@ -325,12 +344,16 @@ cv::Mat draw_classification(const cv::Mat& base, const cv::Mat& depth, const Sce
     for (int u = 0; u < W; ++u) {
       const int l = labels[static_cast<std::size_t>(v) * W + u];
       cv::Vec3b col;
-      if (l >= 0 && l < static_cast<int>(scene.regions.size())) col = region_class_color(scene.regions[l].cls);
-      else if (l <= -2) col = region_class_color(RegionClass::kObstacle);
-      else continue;
+      if (l >= 0 && l < static_cast<int>(scene.regions.size()))
+        col = region_class_color(scene.regions[l].cls);
+      else if (l <= -2)
+        col = region_class_color(RegionClass::kObstacle);
+      else
+        continue;
       cv::Vec3b& px = img.at<cv::Vec3b>(v, u);
       for (int k = 0; k < 3; ++k)
-        px[k] = static_cast<uchar>((1.f - alpha) * static_cast<float>(px[k]) + alpha * static_cast<float>(col[k]));
+        px[k] = static_cast<uchar>((1.f - alpha) * static_cast<float>(px[k]) +
+                                   alpha * static_cast<float>(col[k]));
     }
   }
   return img;

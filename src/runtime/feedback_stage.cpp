@@ -79,11 +79,13 @@ struct FeedbackStage::Impl {
       fb::PressTiming tm{f.button_debounce, f.button_long_press, f.button_double_press};
       button = std::make_unique<fb::ButtonReader>(
           fb::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
-      spdlog::info("button: reading presses on {} (short: where are the stairs; long: mute {:.0f} s; double: "
-                   "verbosity)",
-                   button->describe(), f.mute);
+      spdlog::info(
+          "button: reading presses on {} (short: where are the stairs; long: mute {:.0f} s; double: "
+          "verbosity)",
+          button->describe(), f.mute);
     } catch (const std::exception& e) {
-      spdlog::error("{}; going on without the button (feedback.button_enabled: false silences this)", e.what());
+      spdlog::error("{}; going on without the button (feedback.button_enabled: false silences this)",
+                    e.what());
     }
   }
 
@@ -151,9 +153,10 @@ struct FeedbackStage::Impl {
         if (player->realtime()) {
           spdlog::info("haptic: buzzer on {}, timed at real-time priority", player->describe());
         } else {
-          spdlog::warn("haptic: buzzer on {}, but its timing thread was refused real-time priority "
-                       "(needs root or LimitRTPRIO>={}); pulses may come a few ms late on a busy machine",
-                       player->describe(), fb::HapticPlayer::kRealtimePriority);
+          spdlog::warn(
+              "haptic: buzzer on {}, but its timing thread was refused real-time priority "
+              "(needs root or LimitRTPRIO>={}); pulses may come a few ms late on a busy machine",
+              player->describe(), fb::HapticPlayer::kRealtimePriority);
         }
         haptic = std::move(player);
       } catch (const std::exception& e) {
@@ -176,8 +179,9 @@ struct FeedbackStage::Impl {
     const std::uint64_t now = lost();
     if (now == lost_seen) return;
     const std::uint64_t n = now - lost_seen;
-    spdlog::warn("audio: {} cue{} dropped unplayed: the sound device '{}' could not take {} in time ({} lost so far)",
-                 n, n == 1 ? "" : "s", config.feedback.audio_device, n == 1 ? "it" : "them", now);
+    spdlog::warn(
+        "audio: {} cue{} dropped unplayed: the sound device '{}' could not take {} in time ({} lost so far)",
+        n, n == 1 ? "" : "s", config.feedback.audio_device, n == 1 ? "it" : "them", now);
     lost_seen = now;
   }
 
@@ -312,8 +316,8 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
   // The battery, every battery_poll s (a few small sysfs reads, on the feedback thread).
   const FeedbackConfig& f = impl_->config.feedback;
   if (now >= impl_->next_battery_poll) {
-    impl_->next_battery_poll =
-        now + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(f.battery_poll));
+    impl_->next_battery_poll = now + std::chrono::duration_cast<SteadyClock::duration>(
+                                         std::chrono::duration<double>(f.battery_poll));
     const fb::BatteryStatus b = fb::read_battery(f.power_supply_dir);
     if (b.present != impl_->battery_seen) {
       impl_->battery_seen = b.present;
@@ -321,7 +325,8 @@ Decision FeedbackStage::decide(const PerceptionOutput& perception, const Odometr
         spdlog::info("battery: {} in {} at {:.0f}%{}", b.name, f.power_supply_dir, b.charge * 100.f,
                      b.charging ? ", charging" : "");
     }
-    for (const auto& e : impl_->policy.battery(timestamp_s, b.present, b.charge, b.charging)) cues.push_back(e);
+    for (const auto& e : impl_->policy.battery(timestamp_s, b.present, b.charge, b.charging))
+      cues.push_back(e);
     std::stable_sort(cues.begin(), cues.end(),
                      [](const fb::CueEvent& a, const fb::CueEvent& b) { return a.priority > b.priority; });
   }
@@ -354,12 +359,14 @@ void FeedbackStage::reconfigure(const PipelineConfig& config) {
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
   if (impl_->sinks_open &&
       (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
-       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled || a.stereo_pan != b.stereo_pan ||
-       a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line || a.language != b.language ||
-       a.button_enabled != b.button_enabled || a.button_chip != b.button_chip || a.button_line != b.button_line ||
-       a.button_active_low != b.button_active_low || a.button_debounce != b.button_debounce ||
-       a.button_long_press != b.button_long_press || a.button_double_press != b.button_double_press))
-    spdlog::info("feedback: sound device, sounds, language, buzzer and button settings apply at the next start");
+       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
+       a.stereo_pan != b.stereo_pan || a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line ||
+       a.language != b.language || a.button_enabled != b.button_enabled || a.button_chip != b.button_chip ||
+       a.button_line != b.button_line || a.button_active_low != b.button_active_low ||
+       a.button_debounce != b.button_debounce || a.button_long_press != b.button_long_press ||
+       a.button_double_press != b.button_double_press))
+    spdlog::info(
+        "feedback: sound device, sounds, language, buzzer and button settings apply at the next start");
   PipelineConfig keep = config;
   const FeedbackConfig old = impl_->config.feedback;
   keep.feedback = b;

@@ -141,7 +141,8 @@ struct PerceptionStage::Impl {
 PerceptionStage::PerceptionStage(const PipelineConfig& config) : impl_(std::make_unique<Impl>(config)) {}
 PerceptionStage::~PerceptionStage() = default;
 
-PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry) {
+PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq,
+                                       const OdometryLookup& odometry) {
   const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   m.perception.process(frame, m.scene);
@@ -164,7 +165,8 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
   out.stair = summarize(m.stair);
   // Drop-offs: the floor ending with nothing within a step below (a descent is the stair stage's).
   SceneResult carried;
-  const DropResult drop = detect_drop(frame, drop_scene(frame, static_cast<bool>(odometry), carried), m.config.drops);
+  const DropResult drop =
+      detect_drop(frame, drop_scene(frame, static_cast<bool>(odometry), carried), m.config.drops);
   out.drop = summarize_drop(drop, m.stair);
   // The tracker: the pose of this frame when the odometry has it; otherwise the tracker takes the
   // camera to be where it was and lets the live view correct the staircase.
@@ -178,12 +180,14 @@ PerceptionOutput PerceptionStage::step(const RgbdFrame& frame, std::uint64_t seq
     out.levels = m.stair.levels;
     char buf[200];
     if (m.stair.without_floor)
-      std::snprintf(buf, sizeof buf,
-                    "%s, %d levels seen, riser %.1f cm, tread %.1f cm, no floor in view: distance and first step "
-                    "unknown",
-                    to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m);
+      std::snprintf(
+          buf, sizeof buf,
+          "%s, %d levels seen, riser %.1f cm, tread %.1f cm, no floor in view: distance and first step "
+          "unknown",
+          to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m);
     else
-      std::snprintf(buf, sizeof buf, "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
+      std::snprintf(buf, sizeof buf,
+                    "%s, %d levels, riser %.1f cm, tread %.1f cm, width %.2f m, %.2f m ahead",
                     to_string(m.stair.kind), m.stair.levels, 100.0 * m.stair.riser_m, 100.0 * m.stair.tread_m,
                     m.stair.width_m, m.stair.origin().norm());
     // The building code describes what was found (steep, low risers); it never silenced it.
@@ -231,7 +235,8 @@ const SceneResult& PerceptionStage::drop_scene(const RgbdFrame& frame, bool pose
 // The odometry's pose is asked for only now: running beside perception on the same frame, it has
 // usually finished the frame by the time segmentation has. Perception waits for it only on a view
 // that needs a frame carried; a view seen before its pose came is held when the pose comes.
-void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq, const OdometryLookup& odometry) {
+void PerceptionStage::hold_and_carry(const RgbdFrame& frame, std::uint64_t seq,
+                                     const OdometryLookup& odometry) {
   constexpr std::size_t kMaxPending = 32;
   Impl& m = *impl_;
   auto flush = [&] {

@@ -15,27 +15,28 @@ namespace stairguide::runtime {
 std::string RuntimeStats::summary() const {
   char buf[768];
   const double drop_pct = 100.0 * perception_drop_rate;
-  std::snprintf(
-      buf, sizeof buf,
-      "%s: %llu frames, %.1f fps, odometry %llu (failed %llu, lost %llu), perception %llu "
-      "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, odometry lag p50 %.1f ms p99 %.1f ms, "
-      "camera lost %llu, cfg %llu, timestamps replaced %llu, traversal %s step %d left %d known %d, cues %llu "
-      "(lost %llu, last %s)",
-      state.c_str(), static_cast<unsigned long long>(frames_captured), fps,
-      static_cast<unsigned long long>(odometry_frames), static_cast<unsigned long long>(odometry_failures),
-      static_cast<unsigned long long>(odometry_frames_lost),
-      static_cast<unsigned long long>(perception_frames), perception_fps,
-      static_cast<unsigned long long>(perception_skipped), drop_pct, latency_p50_ms, latency_p99_ms,
-      odometry_lag_p50_ms, odometry_lag_p99_ms, static_cast<unsigned long long>(camera_losses),
-      static_cast<unsigned long long>(config_generation), static_cast<unsigned long long>(timestamps_replaced),
-      traversal_state.c_str(), traversal_step, traversal_left, traversal_known,
-      static_cast<unsigned long long>(cues), static_cast<unsigned long long>(cues_lost),
-      last_cue.empty() ? "-" : last_cue.c_str());
+  std::snprintf(buf, sizeof buf,
+                "%s: %llu frames, %.1f fps, odometry %llu (failed %llu, lost %llu), perception %llu "
+                "(%.1f fps, skipped %llu = %.1f%%), latency p50 %.1f ms p99 %.1f ms, odometry lag p50 %.1f "
+                "ms p99 %.1f ms, "
+                "camera lost %llu, cfg %llu, timestamps replaced %llu, traversal %s step %d left %d known "
+                "%d, cues %llu "
+                "(lost %llu, last %s)",
+                state.c_str(), static_cast<unsigned long long>(frames_captured), fps,
+                static_cast<unsigned long long>(odometry_frames),
+                static_cast<unsigned long long>(odometry_failures),
+                static_cast<unsigned long long>(odometry_frames_lost),
+                static_cast<unsigned long long>(perception_frames), perception_fps,
+                static_cast<unsigned long long>(perception_skipped), drop_pct, latency_p50_ms, latency_p99_ms,
+                odometry_lag_p50_ms, odometry_lag_p99_ms, static_cast<unsigned long long>(camera_losses),
+                static_cast<unsigned long long>(config_generation),
+                static_cast<unsigned long long>(timestamps_replaced), traversal_state.c_str(), traversal_step,
+                traversal_left, traversal_known, static_cast<unsigned long long>(cues),
+                static_cast<unsigned long long>(cues_lost), last_cue.empty() ? "-" : last_cue.c_str());
   return buf;
 }
 
-Runtime::Impl::Impl(const PipelineConfig& c, RuntimeOptions o, Notifier* n)
-    : opt(std::move(o)), notifier(n) {
+Runtime::Impl::Impl(const PipelineConfig& c, RuntimeOptions o, Notifier* n) : opt(std::move(o)), notifier(n) {
   cfg = std::make_shared<const PipelineConfig>(c);
   if (!opt.open_source)
     opt.open_source = [](const std::string& in, const CaptureConfig& cc) {
@@ -131,7 +132,6 @@ RuntimeStats Runtime::Impl::stats() const {
   return s;
 }
 
-
 // ================================ public interface ================================
 
 Runtime::Runtime(const PipelineConfig& config, RuntimeOptions options, Notifier* notifier)
@@ -182,7 +182,8 @@ void Runtime::start() {
       [&m] { m.guarded(kSink, [&m] { m.sink_loop(); }); }};
   for (int w = 0; w < kWorkers; ++w) {
     try {
-      m.threads[w] = m.opt.start_thread ? m.opt.start_thread(worker_name(w), loops[w]) : std::thread(loops[w]);
+      m.threads[w] =
+          m.opt.start_thread ? m.opt.start_thread(worker_name(w), loops[w]) : std::thread(loops[w]);
     } catch (const std::exception& e) {
       request_stop();
       throw StartError(std::string("cannot start the ") + worker_name(w) + " thread: " + e.what());
@@ -202,7 +203,8 @@ int Runtime::run() {
   }
   // Synchronous mode: the same stages in order on this thread, every frame through each.
   std::uint64_t gen = 1;
-  m.guarded(kCapture, [&] { m.run_synchronous(gen); }, "pipeline (one thread)");
+  m.guarded(
+      kCapture, [&] { m.run_synchronous(gen); }, "pipeline (one thread)");
   if (m.done[kCapture].load()) {  // failed (guarded logged it): nothing more to play
     m.source.reset();
     for (auto& d : m.done) d.store(true);

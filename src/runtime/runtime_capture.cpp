@@ -75,9 +75,10 @@ NextFrame Runtime::Impl::next_frame(FramePacket& p) {
     if (r.status == ReadStatus::kEnd) {
       spdlog::info("{}: end of input{}{}", source->describe(), r.message.empty() ? "" : ": ", r.message);
       if (ts_replaced.load() > 0)
-        spdlog::warn("{}: {} of {} frames had a timestamp that could not be trusted and were timed by the "
-                     "frame clock instead",
-                     source->describe(), ts_replaced.load(), next_seq);
+        spdlog::warn(
+            "{}: {} of {} frames had a timestamp that could not be trusted and were timed by the "
+            "frame clock instead",
+            source->describe(), ts_replaced.load(), next_seq);
       return NextFrame::kEnd;
     }
     if (!live) {
@@ -93,8 +94,7 @@ NextFrame Runtime::Impl::next_frame(FramePacket& p) {
                  cfg_now->capture.retry_min, cfg_now->capture.retry_max);
     camera_lost(why);
     source.reset();
-    sleep_interruptible(
-        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(backoff)));
+    sleep_interruptible(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(backoff)));
     backoff = std::min<double>(backoff * 2.0, cfg_now->capture.retry_max);
   }
   return NextFrame::kStopped;
@@ -112,9 +112,11 @@ void Runtime::Impl::check_timestamp(RgbdFrame& f, int fps) {
   const std::uint64_t n = ts_replaced.fetch_add(1) + 1;
   // Every frame of a recording with equal timestamps would warn: the first few, then one in 100.
   if (n <= 5 || n % 100 == 0)
-    spdlog::warn("{}: frame {} (#{} of the run): timestamp {} {}; timed {:.6f} s instead{}", source->describe(),
-                 f.index, next_seq, raw, t.why, t.t,
-                 n == 5 ? " (further ones are logged one in 100)" : n > 5 ? " (" + std::to_string(n) + " so far)" : "");
+    spdlog::warn("{}: frame {} (#{} of the run): timestamp {} {}; timed {:.6f} s instead{}",
+                 source->describe(), f.index, next_seq, raw, t.why, t.t,
+                 n == 5  ? " (further ones are logged one in 100)"
+                 : n > 5 ? " (" + std::to_string(n) + " so far)"
+                         : "");
 }
 
 void Runtime::Impl::pace(double ts, int fps) {
@@ -130,8 +132,7 @@ void Runtime::Impl::pace(double ts, int fps) {
     pace_ts0 = ts;
     pacing_started = true;
   } else {
-    due =
-        pace_t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(ts - pace_ts0));
+    due = pace_t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(ts - pace_ts0));
   }
   last_ts = ts;
   last_due = due;

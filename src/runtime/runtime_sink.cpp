@@ -25,7 +25,8 @@ void Runtime::Impl::on_perception(PercMsg& m) {
     // Learned from the first clear views, relearned when the wearer sits down or remounts the
     // rig: where the floor is looked for from now on.
     spdlog::info("frame {}: rig {}: the camera {:.2f} m above the floor, tilted {:.0f} deg down", m.out.seq,
-                 logged_rig > 0 ? "relearned" : "learned", m.out.rig_height_m, m.out.rig_tilt_rad * 57.29578f);
+                 logged_rig > 0 ? "relearned" : "learned", m.out.rig_height_m,
+                 m.out.rig_tilt_rad * 57.29578f);
     logged_rig = m.out.rig_learned;
   }
   if (!d.cue.empty()) spdlog::info("frame {}: cue {}", m.out.seq, d.cue);
@@ -67,16 +68,20 @@ void Runtime::Impl::print_line(const OdoMsg* o, const PercMsg* p) {
     std::snprintf(pms, sizeof pms, "%.2f", p->out.ms);
   }
   if (o) std::snprintf(oms, sizeof oms, "%.2f", o->out.ms);
-  std::fprintf(
-      opt.frame_out,
-      "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s manhattan=%s "
-      "traversal=%s step=%d left=%d known=%d cue=%s\n",
-      static_cast<unsigned long long>(seq), ts, odom.c_str(), p ? token(p->out.state).c_str() : "skipped",
-      static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms,
-      !p ? "-" : !p->out.manhattan_found ? "none" : p->out.manhattan_carried ? "carried" : "seen",
-      p && p->out.traversal.ran ? to_string(p->out.traversal.state) : "-", p ? p->out.traversal.step_index : 0,
-      p ? p->out.traversal.steps_left : -1, p ? p->out.traversal.steps_known : 0,
-      p && !p->cue.empty() ? p->cue.c_str() : "-");
+  std::fprintf(opt.frame_out,
+               "frame=%llu ts=%.6f odom=%s perception=%s cfg=%llu latency_ms=%s odom_ms=%s perception_ms=%s "
+               "manhattan=%s "
+               "traversal=%s step=%d left=%d known=%d cue=%s\n",
+               static_cast<unsigned long long>(seq), ts, odom.c_str(),
+               p ? token(p->out.state).c_str() : "skipped",
+               static_cast<unsigned long long>(p ? p->config_generation : cfg_gen.load()), lat, oms, pms,
+               !p                         ? "-"
+               : !p->out.manhattan_found  ? "none"
+               : p->out.manhattan_carried ? "carried"
+                                          : "seen",
+               p && p->out.traversal.ran ? to_string(p->out.traversal.state) : "-",
+               p ? p->out.traversal.step_index : 0, p ? p->out.traversal.steps_left : -1,
+               p ? p->out.traversal.steps_known : 0, p && !p->cue.empty() ? p->cue.c_str() : "-");
   std::fflush(opt.frame_out);
 }
 
@@ -168,15 +173,16 @@ void Runtime::Impl::maybe_report(bool force) {
       "%s: capture %.1f fps, odometry %.1f fps, perception %.1f fps, skipped %.0f (%.1f%%), lost %.0f, "
       "latency p50 %.1f ms p99 %.1f ms, odometry lag p50 %.1f ms p99 %.1f ms, totals %llu frames %llu "
       "skipped %llu lost, cfg %llu",
-      state_name(get_state()), d(0) * inv, d(1) * inv, d(2) * inv, d(3),
-      seen > 0 ? 100.0 * d(3) / seen : 0.0, d(4), p50, p99, lag50, lag99, static_cast<unsigned long long>(cur[0]),
+      state_name(get_state()), d(0) * inv, d(1) * inv, d(2) * inv, d(3), seen > 0 ? 100.0 * d(3) / seen : 0.0,
+      d(4), p50, p99, lag50, lag99, static_cast<unsigned long long>(cur[0]),
       static_cast<unsigned long long>(cur[3]), static_cast<unsigned long long>(cur[4]),
       static_cast<unsigned long long>(cfg_gen.load()));
   // The step count and its cues are only as fresh as the odometry's poses.
   if (lag99 > kLagWarnMs)
-    spdlog::warn("odometry {:.1f} s behind the camera (p99 over the last {:.1f} s): step counts and their cues "
-                 "come that late; the machine is too slow for this frame size and rate",
-                 lag99 / 1000.0, dt);
+    spdlog::warn(
+        "odometry {:.1f} s behind the camera (p99 over the last {:.1f} s): step counts and their cues "
+        "come that late; the machine is too slow for this frame size and rate",
+        lag99 / 1000.0, dt);
   std::copy(cur, cur + 5, status_base);
   last_status = now;
   spdlog::info("{}", buf);

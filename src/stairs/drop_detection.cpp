@@ -28,20 +28,20 @@ float floor_tol(float z) { return 0.04f + 0.004f * z * z; }
 
 // One sampled pixel, in the floor frame F (x left, y up, z forward; y = 0 on the floor).
 struct Sample {
-  bool valid = false;     // a depth reading
-  float y = 0.f;          // m, height of the reading above the floor
+  bool valid = false;            // a depth reading
+  float y = 0.f;                 // m, height of the reading above the floor
   Eigen::Vector2f xz{0.f, 0.f};  // m, the reading's ground position (x, z) relative to the camera foot
-  float floor_range = 0.f;  // m, where the ray would meet the floor (continued), from the camera foot
-  float floor_depth = 0.f;  // m, camera depth at which it would meet it
-  bool floor_seen = false;  // that floor point would be read (in range, not grazing)
+  float floor_range = 0.f;       // m, where the ray would meet the floor (continued), from the camera foot
+  float floor_depth = 0.f;       // m, camera depth at which it would meet it
+  bool floor_seen = false;       // that floor point would be read (in range, not grazing)
 };
 
 // What one column says: the floor's last reading before what lies beyond it.
 struct ColumnEdge {
-  bool edge = false;   // the floor ends before a drop (deep) or before nothing (missing)
-  bool deep = false;   // a surface seen more than min_depth below the floor beyond it
+  bool edge = false;  // the floor ends before a drop (deep) or before nothing (missing)
+  bool deep = false;  // a surface seen more than min_depth below the floor beyond it
   Eigen::Vector2f xz{0.f, 0.f};
-  float depth = 0.f;   // m below the floor (median of the deep readings)
+  float depth = 0.f;  // m below the floor (median of the deep readings)
 };
 
 struct Geometry {
@@ -52,7 +52,8 @@ struct Geometry {
 
 Sample sample_at(const Geometry& g, const cv::Mat& depth, int u, int v, const DropConfig& cfg) {
   Sample s;
-  const Eigen::Vector3f r((static_cast<float>(u) - g.K->cx) / g.K->fx, (static_cast<float>(v) - g.K->cy) / g.K->fy, 1.f);
+  const Eigen::Vector3f r((static_cast<float>(u) - g.K->cx) / g.K->fx,
+                          (static_cast<float>(v) - g.K->cy) / g.K->fy, 1.f);
   const Eigen::Vector3f d = g.T.linear() * r;
   if (d.y() < -kMinDown * r.norm()) {
     const float t = -g.c.y() / d.y();
@@ -173,7 +174,8 @@ ColumnEdge scan_column(const Geometry& g, const cv::Mat& depth, int u, int dv, c
     }
     // The floor resumed (a gap in the readings): keep following it. Otherwise something stands on
     // it or a level within a step below it is seen: what lies behind is not known from here.
-    if (resume >= col.size() || !col[resume].valid || std::fabs(col[resume].y) > floor_tol(col[resume].floor_depth))
+    if (resume >= col.size() || !col[resume].valid ||
+        std::fabs(col[resume].y) > floor_tol(col[resume].floor_depth))
       return e;
     i = resume;
   }
@@ -250,7 +252,8 @@ DropResult detect_drop(const RgbdFrame& frame, const SceneResult& scene, const D
     return r;
   };
   if (!cfg.enabled) return done(DropVerdict::kDisabled);
-  if (!scene.floor_found || frame.depth.empty() || frame.depth.type() != CV_32FC1) return done(DropVerdict::kNoFloor);
+  if (!scene.floor_found || frame.depth.empty() || frame.depth.type() != CV_32FC1)
+    return done(DropVerdict::kNoFloor);
   r.ok = true;
   const CameraIntrinsics& K = frame.intrinsics;
   const Geometry g{scene.T_floor_camera, scene.T_floor_camera.translation(), &K};

@@ -37,15 +37,17 @@ void copy_region(const PlaneRegion& src, PlaneRegion& dst) {
 
 }  // namespace
 
-FloorlessStairs::FloorlessStairs(const ClassificationConfig& classification, const StairDetectionConfig& detection,
-                                 const StairModellingConfig& modelling, const FloorConfig& floor)
+FloorlessStairs::FloorlessStairs(const ClassificationConfig& classification,
+                                 const StairDetectionConfig& detection, const StairModellingConfig& modelling,
+                                 const FloorConfig& floor)
     : cls_(classification),
       det_(detection),
       mod_(modelling),
       floor_(floor),
       modelling_(classification, detection, modelling) {}
 
-void FloorlessStairs::riser_positions(const SceneResult& scene, const StairResult& r, int n, float level0_plane) {
+void FloorlessStairs::riser_positions(const SceneResult& scene, const StairResult& r, int n,
+                                      float level0_plane) {
   // Vertical regions facing the user, between two consecutive levels (k: below level k) or above
   // the top one (n + 1), within the staircase's lateral span: where each step starts.
   riser_pos_.assign(static_cast<std::size_t>(n + 2), std::numeric_limits<float>::quiet_NaN());
@@ -56,7 +58,8 @@ void FloorlessStairs::riser_positions(const SceneResult& scene, const StairResul
   const float sin_vert = std::sin(cls_.parallel_threshold), cos_face = std::cos(cls_.parallel_threshold);
   const float half = 0.5f * r.width_m;
   for (const PlaneRegion& reg : scene.regions) {
-    if (reg.points.size() < 40 || std::fabs(reg.normal.dot(up)) > sin_vert || std::fabs(reg.normal.dot(zs)) < cos_face)
+    if (reg.points.size() < 40 || std::fabs(reg.normal.dot(up)) > sin_vert ||
+        std::fabs(reg.normal.dot(zs)) < cos_face)
       continue;
     const std::size_t stride = std::max<std::size_t>(1, reg.points.size() / 300);
     tmp_.clear();
@@ -119,8 +122,8 @@ void FloorlessStairs::run(const SceneResult& scene, const CameraIntrinsics* K, S
   run_cold(scene, K, dir, n, fit, out);
 }
 
-void FloorlessStairs::model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0,
-                            StairResult& out) {
+void FloorlessStairs::model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first,
+                            float level0, StairResult& out) {
   // Steps are chain_[first..] in stair order; level 0 is virtual, at `level0` (up . p).
   const std::size_t m = order_.size();
   const int n = static_cast<int>(chain_.size()) - first;
@@ -180,7 +183,8 @@ void FloorlessStairs::model(const SceneResult& scene, const CameraIntrinsics* K,
   const float sin_vert = std::sin(cls_.parallel_threshold);
   for (std::size_t i = 0; i < scene.regions.size(); ++i) {
     const PlaneRegion& r = scene.regions[i];
-    if (r.points.size() >= 40 && std::fabs(r.normal.dot(up)) <= sin_vert) take(static_cast<int>(i), RegionClass::kVertical);
+    if (r.points.size() >= 40 && std::fabs(r.normal.dot(up)) <= sin_vert)
+      take(static_cast<int>(i), RegionClass::kVertical);
   }
   pseudo_.regions.resize(used);
 
@@ -197,7 +201,8 @@ bool FloorlessStairs::edge_cut(const CameraIntrinsics& K, const StairResult& r, 
   return line_cut(K, r, k, y, r.level_data[static_cast<std::size_t>(k)].edge);
 }
 
-bool FloorlessStairs::line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y, float z) const {
+bool FloorlessStairs::line_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y,
+                               float z) const {
   // Samples along the line across the level: where most lie on (or beyond) the image border, the
   // level's boundary there is where the view ends, not where the level does.
   const StairLevel& l = r.level_data[static_cast<std::size_t>(k)];
@@ -205,20 +210,23 @@ bool FloorlessStairs::line_cut(const CameraIntrinsics& K, const StairResult& r, 
   int cut = 0;
   constexpr int kSamples = 9;
   for (int i = 0; i < kSamples; ++i) {
-    const float a = l.lateral_min + (l.lateral_max - l.lateral_min) * (static_cast<float>(i) + 0.5f) / kSamples;
+    const float a =
+        l.lateral_min + (l.lateral_max - l.lateral_min) * (static_cast<float>(i) + 0.5f) / kSamples;
     const Eigen::Vector3f p = r.T_camera_stair * Eigen::Vector3f(a, y, z);
     if (p.z() < 0.05f) {
       ++cut;
       continue;
     }
     const float u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
-    if (u < margin || v < margin || u > static_cast<float>(K.width) - margin || v > static_cast<float>(K.height) - margin)
+    if (u < margin || v < margin || u > static_cast<float>(K.width) - margin ||
+        v > static_cast<float>(K.height) - margin)
       ++cut;
   }
   return 2 * cut >= kSamples;
 }
 
-void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out) {
+void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n,
+                                   StairResult& out) {
   // Modelling measured each level's step edge from its points. Without a floor the first seen
   // level often runs out of the image (the tread under the camera, or the floor itself when the
   // floor detector refused it), and its "edge" is then the image border: the tread and the origin
@@ -265,8 +273,10 @@ void FloorlessStairs::collect_seen_edges(const SceneResult& scene, const CameraI
   // Nosing: the tread edge's offset from its riser where both are seen and agree.
   tmp_.clear();
   for (int k = 1; k <= n; ++k) {
-    const float d = out.level_data[static_cast<std::size_t>(k)].edge - riser_pos_[static_cast<std::size_t>(k)];
-    const bool seen = !K || !edge_cut(*K, out, k, out.level_data[static_cast<std::size_t>(k)].height - y_origin);
+    const float d =
+        out.level_data[static_cast<std::size_t>(k)].edge - riser_pos_[static_cast<std::size_t>(k)];
+    const bool seen =
+        !K || !edge_cut(*K, out, k, out.level_data[static_cast<std::size_t>(k)].height - y_origin);
     if (seen && std::isfinite(d) && d >= -0.02f && d <= 0.05f) tmp_.push_back(d);
   }
   float nosing = 0.f;
@@ -342,7 +352,6 @@ bool FloorlessStairs::fit_seen_edges(int dir, StairResult& out, float& shift) co
   }
   return true;
 }
-
 
 void FloorlessStairs::shift_origin(int n, float shift, StairResult& out) {
   const Eigen::Vector3f zs = out.T_camera_stair.linear().col(2);

@@ -27,7 +27,8 @@ float FloorlessStairs::seen_floor_height(int dir, float riser) const {
     // On the user's side of the flight: below its first level ascending, above it descending.
     const float a0 = static_cast<float>(dir) * (h0 - f.height);
     const int k = static_cast<int>(std::lround(a0 / riser));
-    if (k < 1 || k > kmax || std::fabs(a0 - static_cast<float>(k) * riser) > det_.floorless_anchor_tolerance) continue;
+    if (k < 1 || k > kmax || std::fabs(a0 - static_cast<float>(k) * riser) > det_.floorless_anchor_tolerance)
+      continue;
     if (f.pixels > best_pixels) {
       best_pixels = f.pixels;
       best = cam_above;
@@ -61,8 +62,10 @@ void FloorlessStairs::run_anchored(const SceneResult& scene, const CameraIntrins
     k = static_cast<int>(std::floor((a0 + tol) / riser)) + 1;
     const float d = static_cast<float>(k) * riser - a0;
     lean = d > tol && d <= 0.5f * (riser + tol);
-    if (lean) trace_.lean = d;
-    else k = -1;
+    if (lean)
+      trace_.lean = d;
+    else
+      k = -1;
   }
   // A chest camera hangs ahead of the feet: with the user at the first edge it is over the first
   // tread, and one more step lies under the view; going down, the levels lie deeper and the view's

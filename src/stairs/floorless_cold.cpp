@@ -89,8 +89,9 @@ void FloorlessStairs::decide_first_level(const SceneResult& scene, const CameraI
   // bottom border lies within a metre or so of the camera and its depth is measured to a few cm;
   // only from a camera held level, whose lowest rows look far and grazing, is anything shallower
   // than a landing left undecided.
-  const float floor_depth = chest_view && out.tread_m > 0.f ? out.tread_m + kFloorDepthSlack
-                                                             : std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
+  const float floor_depth = chest_view && out.tread_m > 0.f
+                                ? out.tread_m + kFloorDepthSlack
+                                : std::max(kLandingDepth, out.tread_m + kFloorDepthSlack);
   const bool deep = depth > floor_depth;
   const bool floor_height = cam_above >= floor_.height_min - det_.same_level_tolerance &&
                             cam_above <= floor_.height_max + det_.same_level_tolerance;
@@ -136,7 +137,8 @@ bool FloorlessStairs::riser_between(const SceneResult& scene, float h_lo, float 
     std::sort(tmp_.begin(), tmp_.end());
     // Its height band (10th to 90th percentile) within the pair's, over a third of the riser.
     const float lo = tmp_[tmp_.size() / 10], hi = tmp_[tmp_.size() * 9 / 10];
-    if (lo >= h_lo - kRiserBandSlack && hi <= h_hi + kRiserBandSlack && hi - lo >= (h_hi - h_lo) / 3.f) return true;
+    if (lo >= h_lo - kRiserBandSlack && hi <= h_hi + kRiserBandSlack && hi - lo >= (h_hi - h_lo) / 3.f)
+      return true;
   }
   return false;
 }

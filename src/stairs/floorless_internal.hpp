@@ -10,12 +10,12 @@
 namespace stairguide {
 namespace floorless {
 
-constexpr int kMinRegionPixels = 100;   // px, smaller regions have too noisy a normal to vote for up
-constexpr std::size_t kFitPoints = 500; // points per region in the fit of the common normal
-constexpr float kLandingDepth = 0.6f;   // m, a level deeper than this is a landing or a floor
-constexpr float kRiserBandSlack = 0.03f;  // m, a riser's height band may pass its levels' heights by this
-constexpr float kMinRise = 0.05f;       // m, a higher level's near boundary this much farther (nearer)
-                                        // than the lower one's says ascending (descending)
+constexpr int kMinRegionPixels = 100;      // px, smaller regions have too noisy a normal to vote for up
+constexpr std::size_t kFitPoints = 500;    // points per region in the fit of the common normal
+constexpr float kLandingDepth = 0.6f;      // m, a level deeper than this is a landing or a floor
+constexpr float kRiserBandSlack = 0.03f;   // m, a riser's height band may pass its levels' heights by this
+constexpr float kMinRise = 0.05f;          // m, a higher level's near boundary this much farther (nearer)
+                                           // than the lower one's says ascending (descending)
 constexpr float kFloorDepthSlack = 0.08f;  // m, a level cut by the image border and seen deeper than
                                            // the tread by this is no tread (nosing, edge noise)
 // With the chest moved towards the next level beyond the anchor tolerance (run_anchored), the user

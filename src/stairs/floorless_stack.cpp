@@ -81,7 +81,9 @@ void FloorlessStairs::build_nodes(const SceneResult& scene) {
     height_[i] = up.dot(scene.regions[static_cast<std::size_t>(family_[i])].centroid);
   order_.resize(family_.size());
   std::iota(order_.begin(), order_.end(), 0);
-  std::sort(order_.begin(), order_.end(), [&](int a, int b) { return height_[static_cast<std::size_t>(a)] < height_[static_cast<std::size_t>(b)]; });
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return height_[static_cast<std::size_t>(a)] < height_[static_cast<std::size_t>(b)];
+  });
 
   std::size_t used = 0;
   auto new_node = [&]() -> Node& {
@@ -105,13 +107,15 @@ void FloorlessStairs::build_nodes(const SceneResult& scene) {
     double sum_h = height_[static_cast<std::size_t>(order_[i])];
     long sum_w = 1;
     {
-      const int px = scene.regions[static_cast<std::size_t>(family_[static_cast<std::size_t>(order_[i])])].pixel_count;
+      const int px =
+          scene.regions[static_cast<std::size_t>(family_[static_cast<std::size_t>(order_[i])])].pixel_count;
       sum_h *= px;
       sum_w = px;
     }
     while (j < order_.size()) {
       const std::size_t m = static_cast<std::size_t>(order_[j]);
-      if (height_[m] - static_cast<float>(sum_h / static_cast<double>(sum_w)) > det_.same_level_tolerance) break;
+      if (height_[m] - static_cast<float>(sum_h / static_cast<double>(sum_w)) > det_.same_level_tolerance)
+        break;
       const int px = scene.regions[static_cast<std::size_t>(family_[m])].pixel_count;
       sum_h += static_cast<double>(height_[m]) * px;
       sum_w += px;
@@ -138,8 +142,9 @@ void FloorlessStairs::build_nodes(const SceneResult& scene) {
   }
   order_.resize(keep);
   std::iota(order_.begin(), order_.end(), 0);
-  std::sort(order_.begin(), order_.end(),
-            [&](int a, int b) { return nodes_[static_cast<std::size_t>(a)].height < nodes_[static_cast<std::size_t>(b)].height; });
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return nodes_[static_cast<std::size_t>(a)].height < nodes_[static_cast<std::size_t>(b)].height;
+  });
   trace_.levels = static_cast<int>(keep);
 }
 
@@ -191,9 +196,11 @@ void FloorlessStairs::build_stack() {
   }
   std::size_t end = 0;
   for (std::size_t j = 1; j < m; ++j)
-    if (best_len_[j] > best_len_[end] || (best_len_[j] == best_len_[end] && best_pix_[j] > best_pix_[end])) end = j;
+    if (best_len_[j] > best_len_[end] || (best_len_[j] == best_len_[end] && best_pix_[j] > best_pix_[end]))
+      end = j;
   chain_.clear();
-  for (int j = static_cast<int>(end); j >= 0; j = best_prev_[static_cast<std::size_t>(j)]) chain_.push_back(order_[static_cast<std::size_t>(j)]);
+  for (int j = static_cast<int>(end); j >= 0; j = best_prev_[static_cast<std::size_t>(j)])
+    chain_.push_back(order_[static_cast<std::size_t>(j)]);
   std::reverse(chain_.begin(), chain_.end());  // lowest first
   trace_.stacked = static_cast<int>(chain_.size());
   for (int c : chain_) trace_.level_heights.push_back(nodes_[static_cast<std::size_t>(c)].height);
@@ -209,9 +216,12 @@ FloorlessStairs::StackDirection FloorlessStairs::stack_direction() {
     const float d = near_distance(nodes_[static_cast<std::size_t>(chain_[k])]);
     trace_.near_distances.push_back(d);
     const int vote = d > prev + kMinRise ? 1 : (d < prev - kMinRise ? -1 : 0);
-    if (k + 1 == chain_.size()) top_vote = vote;
-    else if (vote > 0) ++votes_up;
-    else if (vote < 0) ++votes_down;
+    if (k + 1 == chain_.size())
+      top_vote = vote;
+    else if (vote > 0)
+      ++votes_up;
+    else if (vote < 0)
+      ++votes_down;
     prev = d;
   }
   int n = static_cast<int>(chain_.size());
@@ -272,8 +282,10 @@ int FloorlessStairs::split_at_landing() {
   // A flight leading off to the side of the landing (the lower one of a U, seen past the turn)
   // need not fall away in the view's depth: only a branch that does counts as a flight ahead.
   bool up_ok = true, down_ok = true;
-  for (int k = u + 1; k < n; ++k) up_ok = up_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k - 1)] + kMinRise;
-  for (int k = u - 1; k >= 0; --k) down_ok = down_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k + 1)] + kMinRise;
+  for (int k = u + 1; k < n; ++k)
+    up_ok = up_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k - 1)] + kMinRise;
+  for (int k = u - 1; k >= 0; --k)
+    down_ok = down_ok && d[static_cast<std::size_t>(k)] >= d[static_cast<std::size_t>(k + 1)] + kMinRise;
   // Two levels beyond the landing at least: one pair is no evidence (at the foot of a short climb
   // the floor strip seen in a corner lies farther than the first tread, and the landing farther
   // again: the first tread came nearest, and a flight "down" to the floor strip was told).
@@ -282,11 +294,13 @@ int FloorlessStairs::split_at_landing() {
   down_ok = down_ok && down_levels >= 3;
   if (!up_ok && !down_ok) return 0;
   const bool up = up_ok && (!down_ok || up_levels > down_levels);
-  const std::size_t first = up ? static_cast<std::size_t>(u) : 0, last = up ? chain_.size() : static_cast<std::size_t>(u) + 1;
+  const std::size_t first = up ? static_cast<std::size_t>(u) : 0,
+                    last = up ? chain_.size() : static_cast<std::size_t>(u) + 1;
   const std::vector<int> chain = chain_;  // copies: a vector is not assigned from its own range
   chain_.assign(chain.begin() + static_cast<long>(first), chain.begin() + static_cast<long>(last));
   const std::vector<float> heights = trace_.level_heights;
-  trace_.level_heights.assign(heights.begin() + static_cast<long>(first), heights.begin() + static_cast<long>(last));
+  trace_.level_heights.assign(heights.begin() + static_cast<long>(first),
+                              heights.begin() + static_cast<long>(last));
   trace_.near_distances.assign(d.begin() + static_cast<long>(first), d.begin() + static_cast<long>(last));
   trace_.stacked = static_cast<int>(chain_.size());
   trace_.landing_split = true;

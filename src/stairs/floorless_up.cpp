@@ -20,7 +20,8 @@ bool FloorlessStairs::find_up(const SceneResult& scene) {
     if (r.points.size() < 10 || r.pixel_count < kMinRegionPixels) continue;
     float tilt = 0.f, roll = 0.f;
     tilt_roll(r.normal, tilt, roll);
-    if (std::fabs(roll) > floor_.roll_max || tilt < det_.floorless_tilt_min || tilt > det_.floorless_tilt_max) continue;
+    if (std::fabs(roll) > floor_.roll_max || tilt < det_.floorless_tilt_min || tilt > det_.floorless_tilt_max)
+      continue;
     cand_.push_back(static_cast<int>(i));
   }
   if (cand_.empty()) return false;

@@ -13,7 +13,8 @@ namespace stairguide {
 
 using namespace modelling;
 
-Eigen::Vector3f fit_stair_vertical(const SceneResult& scene, const StairHypothesis& hyp, const Eigen::Vector3f& up0) {
+Eigen::Vector3f fit_stair_vertical(const SceneResult& scene, const StairHypothesis& hyp,
+                                   const Eigen::Vector3f& up0) {
   // All horizontal levels share one normal: centre each level's points on its own mean and fit one
   // direction of least spread to them all. A floor normal 1 degree off tilts every height by
   // 5 mm per 30 cm of tread, so the steps' own points are worth adding.
@@ -184,10 +185,12 @@ Eigen::Vector2f StairModelling::orient_into_staircase(int n, float theta) const 
     // tie, the first and last levels decide.
     int ahead = 0;
     for (int k = 1; k < n; ++k) {
-      const float d = z2.dot(levels_[static_cast<std::size_t>(k + 1)].centroid - levels_[static_cast<std::size_t>(k)].centroid);
+      const float d = z2.dot(levels_[static_cast<std::size_t>(k + 1)].centroid -
+                             levels_[static_cast<std::size_t>(k)].centroid);
       ahead += d > 0.f ? 1 : (d < 0.f ? -1 : 0);
     }
-    if (ahead < 0 || (ahead == 0 && z2.dot(levels_[static_cast<std::size_t>(n)].centroid - levels_[1].centroid) < 0.f))
+    if (ahead < 0 ||
+        (ahead == 0 && z2.dot(levels_[static_cast<std::size_t>(n)].centroid - levels_[1].centroid) < 0.f))
       z2 = -z2;
   } else {
     // One level: the axis direction closest to the way from the user to it.

@@ -30,12 +30,14 @@ bool StairModelling::floor_doubtful(const SceneResult& scene, const StairHypothe
     for (const PlaneRegion& r : scene.regions) {
       if (r.cls != RegionClass::kStepCandidate && r.cls != RegionClass::kObstacle) continue;
       if (std::fabs(r.normal.dot(up)) < cos_par || r.pixel_count < kDoubtfulPixels) continue;
-      if (std::fabs(up.dot(r.centroid) - levels_[0].plane + riser) < det_.same_level_tolerance) doubtful = true;
+      if (std::fabs(up.dot(r.centroid) - levels_[0].plane + riser) < det_.same_level_tolerance)
+        doubtful = true;
     }
     if (K_ && !doubtful) {
       const Eigen::Vector3f p = xs * a_mid + up * levels_[0].plane + zs * (edge_b + fl.depth_min);
       const float margin = 0.04f * static_cast<float>(K_->height);
-      if (p.z() > 0.05f && K_->fy * p.y() / p.z() + K_->cy < static_cast<float>(K_->height) - margin) doubtful = true;
+      if (p.z() > 0.05f && K_->fy * p.y() / p.z() + K_->cy < static_cast<float>(K_->height) - margin)
+        doubtful = true;
     }
     if (doubtful) {
       out.kind = n >= 2 ? StairKind::kAscending : StairKind::kSingleStep;
@@ -75,15 +77,16 @@ bool StairModelling::far_side_out_of_view(const StairFrame& frame, float a_mid, 
                                           const StairLevel& o) const {
   if (!K_) return false;
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
-  const Eigen::Vector3f p =
-      xs * (a_mid + 0.5f * (o.lateral_min + o.lateral_max)) + up * levels_[1].plane + zs * (edge_b + o.depth_max);
+  const Eigen::Vector3f p = xs * (a_mid + 0.5f * (o.lateral_min + o.lateral_max)) + up * levels_[1].plane +
+                            zs * (edge_b + o.depth_max);
   const float margin = 0.02f * static_cast<float>(std::max(K_->width, K_->height));
   const float u = K_->fx * p.x() / p.z() + K_->cx, v = K_->fy * p.y() / p.z() + K_->cy;
   return p.z() < 0.05f || u < margin || v < margin || u > static_cast<float>(K_->width) - margin ||
          v > static_cast<float>(K_->height) - margin;
 }
 
-bool StairModelling::strip_at_floor_edge_shadow(float riser, const StairLevel& o, const StairResult& out) const {
+bool StairModelling::strip_at_floor_edge_shadow(float riser, const StairLevel& o,
+                                                const StairResult& out) const {
   const Eigen::Vector3f cam = out.T_camera_stair.inverse().translation();  // camera in S
   const float H = cam.y(), D = -cam.z();
   if (H > 0.3f && D > 0.f) {
@@ -95,8 +98,9 @@ bool StairModelling::strip_at_floor_edge_shadow(float riser, const StairLevel& o
   return false;
 }
 
-bool StairModelling::surface_above(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame,
-                                   float a_mid, float edge_b, const StairLevel& o) const {
+bool StairModelling::surface_above(const SceneResult& scene, const StairHypothesis& hyp,
+                                   const StairFrame& frame, float a_mid, float edge_b,
+                                   const StairLevel& o) const {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float cos_par = std::cos(cls_.parallel_threshold);
   const auto& level_regions = hyp.levels[1].regions;
@@ -104,11 +108,13 @@ bool StairModelling::surface_above(const SceneResult& scene, const StairHypothes
     const PlaneRegion& r = scene.regions[i];
     if (r.cls != RegionClass::kStepCandidate && r.cls != RegionClass::kObstacle) continue;
     if (std::fabs(r.normal.dot(up)) < cos_par) continue;
-    if (std::find(level_regions.begin(), level_regions.end(), static_cast<int>(i)) != level_regions.end()) continue;
+    if (std::find(level_regions.begin(), level_regions.end(), static_cast<int>(i)) != level_regions.end())
+      continue;
     const float above = up.dot(r.centroid) - levels_[1].plane;
     if (above < 0.05f || above > 2.0f) continue;
     const float a = xs.dot(r.centroid) - a_mid, b = zs.dot(r.centroid) - edge_b;
-    if (a > o.lateral_min + 0.1f && a < o.lateral_max - 0.1f && b > o.depth_min + 0.1f && b < o.depth_max - 0.1f) {
+    if (a > o.lateral_min + 0.1f && a < o.lateral_max - 0.1f && b > o.depth_min + 0.1f &&
+        b < o.depth_max - 0.1f) {
       return true;
     }
   }
@@ -116,8 +122,9 @@ bool StairModelling::surface_above(const SceneResult& scene, const StairHypothes
 }
 
 void StairModelling::decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir,
-                                         const StairFrame& frame, const StairSpan& span, const FloorSeen& floor,
-                                         float riser, const StairOrigin& pose, StairResult& out) const {
+                                         const StairFrame& frame, const StairSpan& span,
+                                         const FloorSeen& floor, float riser, const StairOrigin& pose,
+                                         StairResult& out) const {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float a_mid = span.a_mid, width = span.width;
   const bool* seen = span.seen;
@@ -138,7 +145,8 @@ void StairModelling::decide_single_level(const SceneResult& scene, const StairHy
   // is a single step.
   const bool shallow = depth < det_.single_min_depth - tol;
   const bool other_floor = cut == 2 && far_cut && (!shallow || width >= kOtherFloorWidth);
-  out.kind = (dir < 0 || depth >= det_.curb_min_depth || other_floor) ? StairKind::kCurb : StairKind::kSingleStep;
+  out.kind =
+      (dir < 0 || depth >= det_.curb_min_depth || other_floor) ? StairKind::kCurb : StairKind::kSingleStep;
   const float min_width = det_.single_min_width;
   // A level below the floor is hidden behind the floor's edge up to the edge's shadow: from the
   // camera (height H above the floor, D in front of the edge) a drop of R is seen from D * R / H
@@ -151,7 +159,8 @@ void StairModelling::decide_single_level(const SceneResult& scene, const StairHy
   // beyond the view is one to step onto, whatever lies past it), or is the strip of a drop seen
   // past the floor's edge.
   const bool too_small = width < min_width - tol || (shallow && !far_cut && !shadowed_drop);
-  if (too_small || (shallow && !shadowed_drop && dir > 0 && boxed_in(scene, xs, up, zs, a_mid, edge_b, o, levels_[1].plane))) {
+  if (too_small || (shallow && !shadowed_drop && dir > 0 &&
+                    boxed_in(scene, xs, up, zs, a_mid, edge_b, o, levels_[1].plane))) {
     out.verdict = StairVerdict::kObstacle;
     return;
   }
@@ -192,7 +201,8 @@ void StairModelling::decide_flight(int dir, const StairSpan& span, const StairPr
   dims.width_complete = out.width_complete;
   dims.range = origin.norm();
   out.verdict = check_walkable(dims, tol, cfg_.tread_tolerance_per_m2);
-  if (out.verdict == StairVerdict::kDetected && !edge_consistent) out.verdict = StairVerdict::kInconsistentEdges;
+  if (out.verdict == StairVerdict::kDetected && !edge_consistent)
+    out.verdict = StairVerdict::kInconsistentEdges;
   out.code_notes = describe_against_code(dims, true, cfg_);
   out.detected = out.verdict == StairVerdict::kDetected;
 }
@@ -235,7 +245,8 @@ bool StairModelling::boxed_in(const SceneResult& scene, const Eigen::Vector3f& x
     }
     if (side) {
       const float a = xs.dot(r.centroid) - a_mid;
-      const bool at_min = std::fabs(a - o.lateral_min) < kEndSlack, at_max = std::fabs(a - o.lateral_max) < kEndSlack;
+      const bool at_min = std::fabs(a - o.lateral_min) < kEndSlack,
+                 at_max = std::fabs(a - o.lateral_max) < kEndSlack;
       if (!at_min && !at_max) continue;
       if (b_hi < o.depth_min || b_lo > o.depth_max) continue;
       // Facing the level's middle: at the x_S-high end the normal points to -x_S, and vice versa;

@@ -65,7 +65,8 @@ float StairDetection::view_bottom(const SceneResult& scene) const {
   return low;
 }
 
-bool StairDetection::connected(const Candidate& c, const LevelSeed& level, bool horizontal, float radius) const {
+bool StairDetection::connected(const Candidate& c, const LevelSeed& level, bool horizontal,
+                               float radius) const {
   const float r = radius > 0.f ? radius : cfg_.connection_radius, r2 = r * r;
   const int need = std::max(1, (cfg_.connection_min_points + c.stride - 1) / c.stride);
   int found = 0;
@@ -118,9 +119,11 @@ void StairDetection::build(int direction, StairHypothesis& hyp) {
   // Candidates on this side of the floor, sorted by distance to it (Algorithm 1: sortByHeight).
   order_.clear();
   for (int slot : candidates_)
-    if (pool_[static_cast<std::size_t>(slot)].height * static_cast<float>(direction) > 0.f) order_.push_back(slot);
+    if (pool_[static_cast<std::size_t>(slot)].height * static_cast<float>(direction) > 0.f)
+      order_.push_back(slot);
   std::sort(order_.begin(), order_.end(), [&](int a, int b) {
-    return std::fabs(pool_[static_cast<std::size_t>(a)].height) < std::fabs(pool_[static_cast<std::size_t>(b)].height);
+    return std::fabs(pool_[static_cast<std::size_t>(a)].height) <
+           std::fabs(pool_[static_cast<std::size_t>(b)].height);
   });
   hyp.candidates = static_cast<int>(order_.size());
   assigned_.assign(order_.size(), 0);
@@ -305,7 +308,8 @@ bool StairDetection::build_hidden(StairHypothesis& hyp) {
     if (s <= hmax) continue;
     if (s > static_cast<float>(kMaxHiddenSteps + 1) * hmax) break;
     if (static_cast<int>(c.sample.size()) * c.stride < kDoubtfulMinPoints) continue;
-    if (lowest_row(scene_->regions[static_cast<std::size_t>(c.region)]) < view_bottom_ - kViewBottomSlack) continue;
+    if (lowest_row(scene_->regions[static_cast<std::size_t>(c.region)]) < view_bottom_ - kViewBottomSlack)
+      continue;
     if (!connected(c, floor, true)) continue;
     LevelSeed& l = hyp.levels.emplace_back();
     l.index = 1;  // provisional: set from the stack's spacing below
@@ -379,8 +383,8 @@ bool StairDetection::build_stack(StairHypothesis& hyp) {
       ok = riser >= hmin && riser <= hmax;
       // Every level, the first included, a whole riser above the one below it (the floor at 0).
       for (int k = 1; k <= n && ok; ++k)
-        ok = std::fabs(std::fabs(hyp.levels[static_cast<std::size_t>(k)].height) - static_cast<float>(k) * riser) <=
-             cfg_.same_level_tolerance;
+        ok = std::fabs(std::fabs(hyp.levels[static_cast<std::size_t>(k)].height) -
+                       static_cast<float>(k) * riser) <= cfg_.same_level_tolerance;
     }
     if (ok) return true;
     // Not a flight: undo and try the next candidate at step height (another piece of furniture

@@ -103,7 +103,7 @@ bool StairModelling::far_side_cut(const std::vector<Eigen::Vector2f>& pts, const
 }
 
 StairModelling::LevelExtents StairModelling::level_extents(const StairFrame& frame, int n, int dir,
-                                                          StairResult& out) {
+                                                           StairResult& out) {
   const Eigen::Vector2f &x2 = frame.x2, &z2 = frame.z2;
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   landing_.assign(static_cast<std::size_t>(n + 1), 0);
@@ -167,13 +167,14 @@ bool StairModelling::level_stands_on_lower(int n, const Eigen::Vector2f& x2, con
       const float a = x2.dot(p);
       beyond += z2.dot(p) > hi.depth_max + kBeyond && a >= hi.lateral_min && a <= hi.lateral_max;
     }
-    if (beyond >= std::max<std::size_t>(30, levels_[static_cast<std::size_t>(k + 1)].pts.size() / 4)) return true;
+    if (beyond >= std::max<std::size_t>(30, levels_[static_cast<std::size_t>(k + 1)].pts.size() / 4))
+      return true;
   }
   return false;
 }
 
 StairModelling::StairSpan StairModelling::lateral_span(const StairFrame& frame, int n, int steps_not_landing,
-                                                      const StairResult& out) const {
+                                                       const StairResult& out) const {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const CameraIntrinsics* K = K_;
   StairSpan s;
@@ -249,9 +250,10 @@ bool StairModelling::narrow_level_on_surface(const StairFrame& frame, int n, int
   return false;
 }
 
-StairModelling::FloorSeen StairModelling::floor_before_steps(const SceneResult& scene, const StairHypothesis& hyp,
-                                                            const StairFrame& frame, int n, int dir,
-                                                            const StairSpan& span, StairResult& out) {
+StairModelling::FloorSeen StairModelling::floor_before_steps(const SceneResult& scene,
+                                                             const StairHypothesis& hyp,
+                                                             const StairFrame& frame, int n, int dir,
+                                                             const StairSpan& span, StairResult& out) {
   const Eigen::Vector2f &x2 = frame.x2, &z2 = frame.z2;
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up, &e1 = frame.e1, &e2 = frame.e2;
   const float a_min = span.a_min, a_max = span.a_max, width = span.width;
@@ -314,8 +316,9 @@ StairModelling::FloorSeen StairModelling::floor_before_steps(const SceneResult& 
           a_band_.push_back(a);
         }
       }
-      fl.depth_max = fl.edge =
-          n == 1 ? boundary_median_ab(a_band_, b_, false, BoundaryFrame{xs, zs, up, plane0}) : robust_high(b_);
+      fl.depth_max = fl.edge = n == 1
+                                   ? boundary_median_ab(a_band_, b_, false, BoundaryFrame{xs, zs, up, plane0})
+                                   : robust_high(b_);
       floor_edge = std::isfinite(fl.edge);
     }
   }

@@ -17,7 +17,9 @@ float cross(const Eigen::Vector2f& o, const Eigen::Vector2f& a, const Eigen::Vec
 
 /// Two quantiles of `v` (reordered): the outer one is searched only on its side of the inner one.
 void quantile_pair(std::vector<float>& v, float outer, float inner, float& q_outer, float& q_inner) {
-  const auto at = [&](float q) { return static_cast<long>(std::lround(q * static_cast<float>(v.size() - 1))); };
+  const auto at = [&](float q) {
+    return static_cast<long>(std::lround(q * static_cast<float>(v.size() - 1)));
+  };
   const long io = at(outer), ii = at(inner);
   std::nth_element(v.begin(), v.begin() + ii, v.end());
   q_inner = v[static_cast<std::size_t>(ii)];
@@ -118,6 +120,5 @@ LineFit fit_line(const std::vector<float>& x, const std::vector<float>& y) {
   f.ok = true;
   return f;
 }
-
 
 }  // namespace stairguide

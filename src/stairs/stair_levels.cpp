@@ -46,7 +46,8 @@ void project_level(const SceneResult& scene, const LevelSeed& seed, const Eigen:
       c += out.pts.back();
     }
   }
-  out.centroid = out.pts.empty() ? Eigen::Vector2f::Zero() : Eigen::Vector2f(c / static_cast<float>(out.pts.size()));
+  out.centroid =
+      out.pts.empty() ? Eigen::Vector2f::Zero() : Eigen::Vector2f(c / static_cast<float>(out.pts.size()));
 }
 
 void level_shape(StairLevel2d& L, std::size_t hull_points, std::vector<Eigen::Vector2f>& sub) {
@@ -65,7 +66,8 @@ void level_shape(StairLevel2d& L, std::size_t hull_points, std::vector<Eigen::Ve
   L.extent = ra > 0.f ? polygon_area(L.hull) / ra : 0.f;
 }
 
-StairModelling::LevelsSeen StairModelling::project_levels(const SceneResult& scene, const StairHypothesis& hyp, int n,
+StairModelling::LevelsSeen StairModelling::project_levels(const SceneResult& scene,
+                                                          const StairHypothesis& hyp, int n,
                                                           const StairFrame& frame) {
   const Eigen::Vector3f &up = frame.up, &e1 = frame.e1, &e2 = frame.e2;
   LevelsSeen seen;

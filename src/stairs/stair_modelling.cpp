@@ -8,8 +8,8 @@
 
 namespace stairguide {
 
-StairModelling::StairModelling(const ClassificationConfig& classification, const StairDetectionConfig& detection,
-                               const StairModellingConfig& config)
+StairModelling::StairModelling(const ClassificationConfig& classification,
+                               const StairDetectionConfig& detection, const StairModellingConfig& config)
     : cls_(classification), det_(detection), cfg_(config) {}
 
 void StairModelling::reset_result(const StairHypothesis& hyp, int n, StairResult& out) const {
@@ -75,7 +75,8 @@ void StairModelling::run(const SceneResult& scene, const StairHypothesis& hyp, S
   if (n >= 2) fit_tread(hyp, n, dir, floor, extents.steps_not_landing, span, profile, out);
 
   // Pose: origin at the centre of the first edge; every level in the stair frame.
-  const StairOrigin origin = place_origin(hyp, n, dir, frame, span, floor, extents.near_boundary, profile, out);
+  const StairOrigin origin =
+      place_origin(hyp, n, dir, frame, span, floor, extents.near_boundary, profile, out);
   express_in_stair_frame(scene, hyp, n, dir, origin, span, floor, out);
 
   // Decision.

@@ -11,9 +11,10 @@ namespace stairguide {
 using namespace modelling;
 
 StairModelling::StairOrigin StairModelling::place_origin(const StairHypothesis& hyp, int n, int dir,
-                                                        const StairFrame& frame, const StairSpan& span,
-                                                        const FloorSeen& floor, float near_boundary,
-                                                        const StairProfile& profile, StairResult& out) const {
+                                                         const StairFrame& frame, const StairSpan& span,
+                                                         const FloorSeen& floor, float near_boundary,
+                                                         const StairProfile& profile,
+                                                         StairResult& out) const {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float a_mid = span.a_mid, width = span.width, riser = profile.riser;
   const LineFit& efit = profile.tread;
@@ -58,8 +59,8 @@ StairModelling::StairOrigin StairModelling::place_origin(const StairHypothesis& 
   return o;
 }
 
-void StairModelling::express_in_stair_frame(const SceneResult& scene, const StairHypothesis& hyp, int n, int dir,
-                                            const StairOrigin& origin, const StairSpan& span,
+void StairModelling::express_in_stair_frame(const SceneResult& scene, const StairHypothesis& hyp, int n,
+                                            int dir, const StairOrigin& origin, const StairSpan& span,
                                             const FloorSeen& floor, StairResult& out) const {
   const float edge_b = origin.edge_b, a_mid = span.a_mid;
   const bool floor_edge = floor.edge, floor_extent = floor.extent;

@@ -13,8 +13,9 @@ namespace stairguide {
 
 using namespace modelling;
 
-EdgeLineFit fit_edge_line(const std::vector<float>& k_all, const std::vector<float>& e_all, float max_residual,
-                          std::vector<char>& inlier, std::vector<float>& k_in, std::vector<float>& e_in) {
+EdgeLineFit fit_edge_line(const std::vector<float>& k_all, const std::vector<float>& e_all,
+                          float max_residual, std::vector<char>& inlier, std::vector<float>& k_in,
+                          std::vector<float>& e_in) {
   // Consensus over the lines through two edges: the line most edges lie near (within
   // max_residual), refitted to those.
   const std::vector<float>& fit_k_ = k_all;
@@ -60,7 +61,8 @@ EdgeLineFit fit_edge_line(const std::vector<float>& k_all, const std::vector<flo
   // Most edges must agree: two thirds of them, and at least two.
   fit.consistent = fit.line.ok && 3 * k_in.size() >= 2 * m;
   for (std::size_t k = 0; k < k_in.size(); ++k)
-    fit.max_residual = std::max(fit.max_residual, std::fabs(e_in[k] - (fit.line.intercept + fit.line.slope * k_in[k])));
+    fit.max_residual =
+        std::max(fit.max_residual, std::fabs(e_in[k] - (fit.line.intercept + fit.line.slope * k_in[k])));
   return fit;
 }
 
@@ -89,15 +91,16 @@ float StairModelling::fit_riser(const StairHypothesis& hyp, int n) {
 // edge lies beyond its riser by more than that, the riser (plus the nosing measured on the
 // levels where both agree) stands for the edge. A riser moves an edge nearer, and further only
 // where the tread took in the riser's top rows (far views, below).
-void StairModelling::find_risers(const SceneResult& scene, const StairFrame& frame, int n, const StairSpan& span,
-                                 const StairResult& out) {
+void StairModelling::find_risers(const SceneResult& scene, const StairFrame& frame, int n,
+                                 const StairSpan& span, const StairResult& out) {
   const Eigen::Vector3f &xs = frame.xs, &zs = frame.zs, &up = frame.up;
   const float a_min = span.a_min, a_max = span.a_max;
   riser_at_.assign(static_cast<std::size_t>(n + 1), std::numeric_limits<float>::quiet_NaN());
   riser_n_.assign(static_cast<std::size_t>(n + 1), 0);
   const float sin_vert = std::sin(cls_.parallel_threshold), cos_face = std::cos(cls_.parallel_threshold);
   for (const PlaneRegion& r : scene.regions) {
-    if (r.points.size() < 40 || std::fabs(r.normal.dot(up)) > sin_vert || std::fabs(r.normal.dot(zs)) < cos_face)
+    if (r.points.size() < 40 || std::fabs(r.normal.dot(up)) > sin_vert ||
+        std::fabs(r.normal.dot(zs)) < cos_face)
       continue;
     const std::size_t stride = std::max<std::size_t>(1, r.points.size() / 300);
     tmp_.clear();
@@ -179,8 +182,8 @@ void StairModelling::place_edges_at_risers(const SceneResult& scene, const Stair
   // treads do and are the better measure of every step's start; otherwise a riser replaces only
   // an edge that lies beyond it by more than a nosing (the tread's near rows hidden), or before
   // it by more than an edge's slack (the riser's top rows taken into the tread).
-  const Eigen::Vector3f ray = (xs * 0.5f * (a_min + a_max) + up * levels_[1].plane +
-                               zs * out.level_data[1].edge).normalized();
+  const Eigen::Vector3f ray =
+      (xs * 0.5f * (a_min + a_max) + up * levels_[1].plane + zs * out.level_data[1].edge).normalized();
   const bool grazing = std::fabs(ray.dot(zs)) > std::fabs(ray.dot(up));
   for (int k = 1; k <= n; ++k) {
     StairLevel& o = out.level_data[static_cast<std::size_t>(k)];
@@ -223,7 +226,8 @@ void StairModelling::fit_tread(const StairHypothesis& hyp, int n, int dir, const
   if (any_outlier) {
     float lo = std::numeric_limits<float>::max(), hi = -lo;
     for (int k = 1; k <= n; ++k) {
-      if (outlier_[static_cast<std::size_t>(k)] || (steps_not_landing > 0 && landing_[static_cast<std::size_t>(k)]))
+      if (outlier_[static_cast<std::size_t>(k)] ||
+          (steps_not_landing > 0 && landing_[static_cast<std::size_t>(k)]))
         continue;
       lo = std::min(lo, out.level_data[static_cast<std::size_t>(k)].lateral_min);
       hi = std::max(hi, out.level_data[static_cast<std::size_t>(k)].lateral_max);

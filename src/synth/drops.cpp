@@ -76,7 +76,8 @@ void clutter_before(Scene& s, Rng& rng, const Pose& E, float reach) {
     else if (k == 1)
       add_bench(s, c, rng.uniform(-kPi, kPi), rng.uniform(0.4f, 0.5f), rng.uniform(1.0f, 2.0f), rng);
     else
-      add_crate(s, c, rng.uniform(-kPi, kPi), V3(rng.uniform(0.3f, 0.8f), rng.uniform(0.3f, 0.8f), rng.uniform(0.3f, 1.1f)),
+      add_crate(s, c, rng.uniform(-kPi, kPi),
+                V3(rng.uniform(0.3f, 0.8f), rng.uniform(0.3f, 0.8f), rng.uniform(0.3f, 1.1f)),
                 rng.chance(0.5f) ? wood_material(rng) : metal_material(rng), "clutter");
   }
 }
@@ -100,8 +101,10 @@ void platform_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   two_levels(b.scene, E, H, 30.f, gap, concrete_material(rng), bed);
   const float r0 = rng.uniform(1.0f, 1.6f);
   for (float x : {r0, r0 + 1.435f})  // standard gauge
-    b.scene.add_box_in(E, V3(x - 0.035f, -30.f, -H), V3(x + 0.035f, 30.f, -H + 0.15f), metal_material(rng), "rail");
-  b.scene.add_box_in(E, V3(gap, -30.f, -H - 0.3f), V3(gap + 5.f, 30.f, 0.f), concrete_material(rng), "platform");
+    b.scene.add_box_in(E, V3(x - 0.035f, -30.f, -H), V3(x + 0.035f, 30.f, -H + 0.15f), metal_material(rng),
+                       "rail");
+  b.scene.add_box_in(E, V3(gap, -30.f, -H - 0.3f), V3(gap + 5.f, 30.f, 0.f), concrete_material(rng),
+                     "platform");
   b.scene.add_box_in(E, V3(gap + 4.f, -30.f, 0.f), V3(gap + 4.3f, 30.f, 3.f), wall_material(rng), "wall");
   b.scene.add_box_in(E, V3(-10.f, -30.f, 0.f), V3(-9.7f, 30.f, 3.f), wall_material(rng), "wall");
   clutter_before(b.scene, rng, E, 4.f);
@@ -126,8 +129,8 @@ void dock_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   b.scene.add_box_in(E, V3(-8.f, -20.f, 0.f), V3(-7.7f, 20.f, 4.f), wall_material(rng), "wall");
   for (int i = 0, n = rng.integer(0, 3); i < n; ++i) {  // pallets, 12-15 cm
     const V3 c = E * V3(-rng.uniform(0.8f, 5.f), rng.uniform(-4.f, 4.f), 0.f);
-    add_crate(b.scene, c, rng.uniform(-kPi, kPi), V3(1.2f, 0.8f, rng.uniform(0.12f, 0.15f)), wood_material(rng),
-              "pallet");
+    add_crate(b.scene, c, rng.uniform(-kPi, kPi), V3(1.2f, 0.8f, rng.uniform(0.12f, 0.15f)),
+              wood_material(rng), "pallet");
   }
   clutter_before(b.scene, rng, E, 5.f);
 }
@@ -165,10 +168,11 @@ void sunken_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float depth = rng.uniform(0.3f, 0.8f), P = rng.uniform(2.f, 5.f), half = rng.uniform(2.f, 6.f);
   const Material fl = floor_material(rng);
   b.scene.add_box_in(E, V3(-14.f, -20.f, -depth - 0.3f), V3(0.f, 20.f, 0.f), fl, "floor");
-  b.scene.add_box_in(E, V3(0.f, -half, -depth - 0.3f), V3(P, half, -depth), rng.chance(0.5f) ? fl : floor_material(rng),
-                     "lower_floor");
+  b.scene.add_box_in(E, V3(0.f, -half, -depth - 0.3f), V3(P, half, -depth),
+                     rng.chance(0.5f) ? fl : floor_material(rng), "lower_floor");
   for (float s : {-1.f, 1.f})  // the floor on either side of the pit, level with the wearer's
-    b.scene.add_box_in(E, V3(0.f, s > 0 ? half : -20.f, -depth - 0.3f), V3(P, s > 0 ? 20.f : -half, 0.f), fl, "floor");
+    b.scene.add_box_in(E, V3(0.f, s > 0 ? half : -20.f, -depth - 0.3f), V3(P, s > 0 ? 20.f : -half, 0.f), fl,
+                       "floor");
   label_edge(b.scene, E, V3(0.f, -half, 0.f), V3(0.f, half, 0.f), V3::UnitX(), depth);
   const Material wall = wall_material(rng);
   if (rng.chance(0.5f))
@@ -176,9 +180,10 @@ void sunken_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   else
     b.scene.add_box_in(E, V3(P, -20.f, -depth - 0.3f), V3(P + 6.f, 20.f, 0.f), fl, "floor");
   if (rng.chance(0.5f))
-    add_crate(b.scene, E * V3(rng.uniform(0.8f, P - 0.5f), rng.uniform(-1.f, 1.f), -depth), rng.uniform(-kPi, kPi),
-              V3(rng.uniform(0.5f, 1.2f), rng.uniform(0.4f, 0.7f), rng.uniform(0.35f, 0.45f)), wood_material(rng),
-              "table");
+    add_crate(b.scene, E * V3(rng.uniform(0.8f, P - 0.5f), rng.uniform(-1.f, 1.f), -depth),
+              rng.uniform(-kPi, kPi),
+              V3(rng.uniform(0.5f, 1.2f), rng.uniform(0.4f, 0.7f), rng.uniform(0.35f, 0.45f)),
+              wood_material(rng), "table");
   clutter_before(b.scene, rng, E, 3.f);
 }
 
@@ -194,7 +199,8 @@ void platform_walk(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   b.scene.add_box_in(E, V3(5.f, -30.f, -H - 0.3f), V3(10.f, 30.f, 0.f), concrete_material(rng), "platform");
   b.scene.add_box_in(E, V3(9.f, -30.f, 0.f), V3(9.3f, 30.f, 3.f), wall_material(rng), "wall");
   for (float x : {1.3f, 2.735f})
-    b.scene.add_box_in(E, V3(x - 0.035f, -30.f, -H), V3(x + 0.035f, 30.f, -H + 0.15f), metal_material(rng), "rail");
+    b.scene.add_box_in(E, V3(x - 0.035f, -30.f, -H), V3(x + 0.035f, 30.f, -H + 0.15f), metal_material(rng),
+                       "rail");
   clutter_before(b.scene, rng, E, 4.f);
   b.sequence = true;
   WalkSpec& w = b.walk;
@@ -207,7 +213,9 @@ void platform_walk(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const float stop = edge_x - rng.uniform(0.45f, 0.7f), speed = rng.uniform(0.9f, 1.3f);
   const double t0 = 0.5, t1 = t0 + 1.8 * stop / speed, t_turn = t1 + 2.0;
   w.duration_s = static_cast<float>(t_turn + 2.5);
-  w.distance = [=](double t) { return stop * smooth_ramp(static_cast<float>(t), static_cast<float>(t0), static_cast<float>(t1)); };
+  w.distance = [=](double t) {
+    return stop * smooth_ramp(static_cast<float>(t), static_cast<float>(t0), static_cast<float>(t1));
+  };
   const float away = rng.chance(0.5f) ? 1.f : -1.f;
   w.heading = [=](double t) {
     const float tt = static_cast<float>(t);
@@ -237,15 +245,18 @@ constexpr float kMinSeen = 0.3f;
 const std::vector<PresetDef>& drop_defs() {
   static const std::vector<PresetDef> defs = {
       def("drop_platform_static",
-          "a railway or tram platform's edge 0.5-4 m ahead: the track bed 0.55-1.3 m below, rails, the opposite "
+          "a railway or tram platform's edge 0.5-4 m ahead: the track bed 0.55-1.3 m below, rails, the "
+          "opposite "
           "platform; people, benches, bins",
           platform_static),
-      def("drop_dock_static", "a loading dock's edge 0.5-4 m ahead, the yard 0.9-1.4 m below; bumpers, pallets, a trailer",
+      def("drop_dock_static",
+          "a loading dock's edge 0.5-4 m ahead, the yard 0.9-1.4 m below; bumpers, pallets, a trailer",
           dock_static),
-      def("drop_hole_static", "a hole in the floor (open pit, trapdoor) 0.6-2.5 m across and 0.3-1.5 m deep, 0.5-4 m ahead",
+      def("drop_hole_static",
+          "a hole in the floor (open pit, trapdoor) 0.6-2.5 m across and 0.3-1.5 m deep, 0.5-4 m ahead",
           hole_static),
-      def("drop_sunken_static", "a sunken floor 0.3-0.8 m below the room's, its edge 0.5-4 m ahead, no step down",
-          sunken_static),
+      def("drop_sunken_static",
+          "a sunken floor 0.3-0.8 m below the room's, its edge 0.5-4 m ahead, no step down", sunken_static),
       def("drop_platform_walk",
           "walk 4-5 m towards a platform edge (0.8-1.3 m drop), stop 0.45-0.7 m before it, stand, turn away",
           platform_walk, 460),
@@ -255,8 +266,8 @@ const std::vector<PresetDef>& drop_defs() {
 
 // The nearest point of a drop edge the camera sees with the floor on the wearer's side of it:
 // sampled every 2 cm; in view with at least 0.3 m of edge seen.
-void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal, const CameraIntrinsics& K,
-                const SynthOptions& o, FrameTruth& t) {
+void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal,
+                const CameraIntrinsics& K, const SynthOptions& o, FrameTruth& t) {
   if (scene.drops.empty()) return;
   const Pose T_cw = walker.T_world_camera.inverse();
   const V3 cam = walker.T_world_camera.translation();

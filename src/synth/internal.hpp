@@ -60,9 +60,10 @@ const std::vector<PresetDef>& world2_defs();
 const std::vector<PresetDef>& drop_defs();
 /// True when the point (camera frame) is seen in the ideal render `depth`: it projects into the
 /// image and a pixel of its 3x3 neighbourhood has a rendered depth close to its own (truth.cpp).
-bool point_seen(const Eigen::Vector3f& p, const cv::Mat& depth, const CameraIntrinsics& K, const SynthOptions& o);
-void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal, const CameraIntrinsics& K,
-                const SynthOptions& o, FrameTruth& t);
+bool point_seen(const Eigen::Vector3f& p, const cv::Mat& depth, const CameraIntrinsics& K,
+                const SynthOptions& o);
+void drop_truth(const Scene& scene, const WalkerState& walker, const RenderBuffers& ideal,
+                const CameraIntrinsics& K, const SynthOptions& o, FrameTruth& t);
 // nullptr when unknown.
 const PresetDef* find_preset(const std::string& name);
 std::uint64_t name_hash(const std::string& s);

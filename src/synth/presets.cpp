@@ -18,8 +18,9 @@ float pick(float v, float fallback) { return std::isnan(v) ? fallback : v; }
 // A view from the world origin (the user stands at the origin on the floor) looking roughly along
 // `heading` (rad), the camera h_lo..h_hi m high and tilted tilt_lo..tilt_hi deg down unless the
 // options fix them; the height and tilt drawn are returned through `height` / `tilt_out`.
-WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo, float tilt_hi,
-                             float heading, float yaw_range_deg, float* height, float* tilt_out) {
+WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo,
+                             float tilt_hi, float heading, float yaw_range_deg, float* height,
+                             float* tilt_out) {
   const float h = pick(o.camera_height_m, rng.uniform(h_lo, h_hi));
   const float tilt = deg2rad(pick(o.camera_tilt_deg, rng.uniform(tilt_lo, tilt_hi)));
   const float roll = deg2rad(pick(o.camera_roll_deg, rng.uniform(-3.f, 3.f)));

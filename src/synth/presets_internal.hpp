@@ -13,12 +13,14 @@ using V2 = Eigen::Vector2f;
 // A view from the world origin (the user stands at the origin on the floor) looking roughly along
 // `heading` (rad), the camera h_lo..h_hi m high and tilted tilt_lo..tilt_hi deg down unless the
 // options fix them; the height and tilt drawn are returned through `height` / `tilt_out`.
-WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo, float tilt_hi,
-                             float heading, float yaw_range_deg, float* height = nullptr, float* tilt_out = nullptr);
+WalkerState view_from_origin(Rng& rng, const SynthOptions& o, float h_lo, float h_hi, float tilt_lo,
+                             float tilt_hi, float heading, float yaw_range_deg, float* height = nullptr,
+                             float* tilt_out = nullptr);
 // A random chest-camera view from the world origin, looking roughly along `heading` (rad).
 WalkerState random_view(Rng& rng, const SynthOptions& o, float heading = 0.f, float yaw_range_deg = 25.f);
 // A floor slab at floor_z and walls around [lo, hi] from wall_bottom up to 2.7 m above the floor.
-void floor_and_room(Scene& s, Rng& rng, const V2& lo, const V2& hi, float floor_z = 0.f, float wall_bottom = 0.f);
+void floor_and_room(Scene& s, Rng& rng, const V2& lo, const V2& hi, float floor_z = 0.f,
+                    float wall_bottom = 0.f);
 // Staircase 0.8-3.0 m ahead of the user at the origin, travel direction `yaw`.
 Pose stair_ahead(Rng& rng, float yaw, float edge_z, float* dist = nullptr);
 // A descending flight ahead in a room of walls down to its foot.

@@ -40,9 +40,11 @@ void rig_furniture_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     add_table(b.scene, (near_edge + 0.5f * dep) * fwd + lat * left, yaw + 1.5707963f, top, len, dep, rng);
   } else if (kind == 1) {  // bed
     const V3 size(rng.uniform(1.9f, 2.1f), rng.uniform(0.9f, 1.6f), top);
-    add_crate(b.scene, (near_edge + 0.5f * size.x()) * fwd + lat * left, yaw, size, fabric_material(rng), "bed");
+    add_crate(b.scene, (near_edge + 0.5f * size.x()) * fwd + lat * left, yaw, size, fabric_material(rng),
+              "bed");
   } else if (kind == 2) {  // bench
-    add_bench(b.scene, (near_edge + 0.2f) * fwd + lat * left, yaw + 1.5707963f, top, rng.uniform(1.2f, 2.0f), rng);
+    add_bench(b.scene, (near_edge + 0.2f) * fwd + lat * left, yaw + 1.5707963f, top, rng.uniform(1.2f, 2.0f),
+              rng);
   } else {  // a raised landing
     const V3 size(rng.uniform(1.2f, 2.5f), rng.uniform(1.2f, 2.5f), top);
     add_crate(b.scene, (near_edge + 0.5f * size.x()) * fwd + lat * left, yaw, size, concrete_material(rng),
@@ -54,14 +56,16 @@ void rig_furniture_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
 
 const std::vector<PresetDef>& rig_defs() {
   static const std::vector<PresetDef> defs = {
-      def("rig_floor_static", "an empty room seen from any rig: camera 0.5-1.8 m high, tilted 15-80 deg", 1, false,
+      def("rig_floor_static", "an empty room seen from any rig: camera 0.5-1.8 m high, tilted 15-80 deg", 1,
+          false,
           [](Rng& rng, const SynthOptions& o, PresetBuild& b) {
             room(rng, b);
             b.view = rig_view(rng, o);
           }),
       def("rig_furniture_static",
-          "any rig (0.5-1.8 m, 15-80 deg) before a table, bed, bench or raised landing 0.4-0.8 m below the camera", 1,
-          false, rig_furniture_static),
+          "any rig (0.5-1.8 m, 15-80 deg) before a table, bed, bench or raised landing 0.4-0.8 m below the "
+          "camera",
+          1, false, rig_furniture_static),
   };
   return defs;
 }

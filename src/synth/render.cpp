@@ -41,7 +41,7 @@ struct FaceShade {
   float tu, tv, t0, tb;
   const float* tex;
   float contrast;
-  float col[3];  // 255 * Lambert * albedo (BGR)
+  float col[3];        // 255 * Lambert * albedo (BGR)
   float relief = 0.f;  // m, Material::relief_m
 };
 
@@ -58,7 +58,8 @@ inline float texture_at(const FaceShade& s, float ts, float tt) {
   const float ax = ts - static_cast<float>(is), ay = tt - static_cast<float>(it);
   const int x0 = is & (TN - 1), y0 = it & (TN - 1);
   const int x1 = (x0 + 1) & (TN - 1), y1 = (y0 + 1) & (TN - 1);
-  const float a = s.tex[y0 * TN + x0], b = s.tex[y0 * TN + x1], c = s.tex[y1 * TN + x0], d = s.tex[y1 * TN + x1];
+  const float a = s.tex[y0 * TN + x0], b = s.tex[y0 * TN + x1], c = s.tex[y1 * TN + x0],
+              d = s.tex[y1 * TN + x1];
   const float top = a + (b - a) * ax, bot = c + (d - c) * ax;
   return top + (bot - top) * ay;
 }
@@ -173,9 +174,8 @@ std::vector<int> rasterize(const Scene& scene, const Pose& T_cw, const CameraInt
 
 // Phase 2: the per-face terms of the per-pixel pass (light is directional, so Lambert is constant
 // per face; colour = albedo * Lambert * (1 + contrast * texture)).
-std::vector<FaceShade> face_terms(const Scene& scene, const Pose& T_world_camera,
-                                  const Eigen::Matrix3f& R_cw, const CameraIntrinsics& K,
-                                  const std::vector<int>& drawn) {
+std::vector<FaceShade> face_terms(const Scene& scene, const Pose& T_world_camera, const Eigen::Matrix3f& R_cw,
+                                  const CameraIntrinsics& K, const std::vector<int>& drawn) {
   const float fx = K.fx, fy = K.fy, cx = K.cx, cy = K.cy;
   const auto& faces = scene.faces();
   const Eigen::Vector3f light = scene.light_dir.normalized();

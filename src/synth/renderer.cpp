@@ -105,7 +105,8 @@ const std::vector<PresetInfo>& world2_presets() {
 }
 
 const PresetInfo* find_preset_info(const std::string& name) {
-  for (const auto* l : {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets(), &drop_presets()})
+  for (const auto* l :
+       {&presets(), &world_presets(), &walk_presets(), &rig_presets(), &world2_presets(), &drop_presets()})
     for (const auto& p : *l)
       if (p.name == name) return &p;
   return nullptr;
@@ -149,7 +150,8 @@ void render_preset_frame(const std::string& preset, long index, std::uint32_t se
   render_into(pf.scene, pf.walker, index, seed, options, buf, frame, truth);
 }
 
-PresetRenderer::PresetRenderer(const std::string& preset, long frames, std::uint32_t seed, const SynthOptions& o)
+PresetRenderer::PresetRenderer(const std::string& preset, long frames, std::uint32_t seed,
+                               const SynthOptions& o)
     : def_(&need_preset(preset)), seed_(seed), options_(o) {
   check_options(o);
   frames_ = frames > 0 ? frames : def_->info.default_frames;

@@ -97,7 +97,8 @@ cv::Mat multipath_bias(const RenderBuffers& ideal, const CameraIntrinsics& K, co
     cv::Vec3f* p = P.ptr<cv::Vec3f>(v);
     for (int u = 0; u < W; ++u)
       if (z[u] > 0.f)
-        p[u] = cv::Vec3f((static_cast<float>(u) - K.cx) / K.fx * z[u], (static_cast<float>(v) - K.cy) / K.fy * z[u], z[u]);
+        p[u] = cv::Vec3f((static_cast<float>(u) - K.cx) / K.fx * z[u],
+                         (static_cast<float>(v) - K.cy) / K.fy * z[u], z[u]);
   }
   auto vec = [](const cv::Vec3f& a) { return Eigen::Vector3f(a[0], a[1], a[2]); };
   for (int v = 1; v + 1 < H; ++v)
@@ -177,12 +178,18 @@ SynthOptions with_real_artefacts(RealSensor sensor, SynthOptions o) {
 
 bool sensor_options(const std::string& noise, SynthOptions& o) {
   if (noise == "white") return true;
-  if (noise == "kinect") o = with_real_kinect_noise(o);
-  else if (noise == "real-v1") o = with_real_artefacts(RealSensor::kKinectV1, o);
-  else if (noise == "real-v2") o = with_real_artefacts(RealSensor::kKinectV2, o);
-  else if (noise == "tof-v2") o = with_real_artefacts(RealSensor::kKinectV2Native, o);
-  else if (noise == "sl-v1") o = with_real_artefacts(RealSensor::kStructuredLight, o);
-  else return false;
+  if (noise == "kinect")
+    o = with_real_kinect_noise(o);
+  else if (noise == "real-v1")
+    o = with_real_artefacts(RealSensor::kKinectV1, o);
+  else if (noise == "real-v2")
+    o = with_real_artefacts(RealSensor::kKinectV2, o);
+  else if (noise == "tof-v2")
+    o = with_real_artefacts(RealSensor::kKinectV2Native, o);
+  else if (noise == "sl-v1")
+    o = with_real_artefacts(RealSensor::kStructuredLight, o);
+  else
+    return false;
   return true;
 }
 
@@ -323,8 +330,10 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
     // The blurred field's variance: the kernel's sum of squares, squared (separable).
     const double ss = k.dot(k);
     field *= std::sqrt(share) / std::sqrt(ss * ss);
-    if (correlated.empty()) correlated = field;
-    else correlated += field;
+    if (correlated.empty())
+      correlated = field;
+    else
+      correlated += field;
   };
   add_blurred(short_share, o.noise_short_px, 0x5eed0001ull);
   add_blurred(long_share, o.noise_long_px, 0x5eed0002ull);

@@ -10,9 +10,8 @@ namespace stairguide::synth {
 namespace {
 
 constexpr int kMinTreadPixels = 200;
-constexpr float kEdgeSpacing = 0.02f;  // m between samples of the first edge
+constexpr float kEdgeSpacing = 0.02f;     // m between samples of the first edge
 constexpr float kMinRiserHeight = 0.08f;  // m, a wall or riser face at least this tall (wall_or_riser_pixels)
-
 
 }  // namespace
 
@@ -70,7 +69,8 @@ FrameTruth compute_truth(const Scene& scene, const WalkerState& walker, const Re
       const Solid& so = scene.solids()[static_cast<std::size_t>(fc.solid)];
       float z_lo = fc.vertices.front().z(), z_hi = z_lo;
       for (const Eigen::Vector3f& q : fc.vertices) z_lo = std::min(z_lo, q.z()), z_hi = std::max(z_hi, q.z());
-      face_upright[f] = (so.label == "wall" || so.label == "riser" || so.stair >= 0) && z_hi - z_lo >= kMinRiserHeight;
+      face_upright[f] =
+          (so.label == "wall" || so.label == "riser" || so.stair >= 0) && z_hi - z_lo >= kMinRiserHeight;
     }
   }
   // A tread pixel counts as visible only where the depth sensor gives a reading: a far tread

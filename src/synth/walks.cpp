@@ -15,8 +15,8 @@ struct FlightWalk {
   StairKind kind = StairKind::kAscending;
   int steps = 8;
   float rate_lo = 0.8f, rate_hi = 1.0f;  // steps per second on the flight
-  bool pause_turn = false;  // stop halfway up (or down) and look round to the left and back
-  bool person = false;      // a person standing at one side of the flight, facing the user
+  bool pause_turn = false;               // stop halfway up (or down) and look round to the left and back
+  bool person = false;                   // a person standing at one side of the flight, facing the user
 };
 
 // Stand, walk ~2 m to the first edge, take the flight at the preset's rate (one tread per step),
@@ -40,11 +40,13 @@ void flight_walk(Rng& rng, const SynthOptions& o, PresetBuild& b, const FlightWa
   const float total = N * p.riser_m;
   const float end = edge_x + (N - 1.f) * p.tread_m + p.top_depth_m;
   if (down) {
-    add_room_walls(b.scene, V2(-2.f, -2.4f), V2(end + 0.1f, 2.4f), -total - 0.2f, 2.9f + total, wall_material(rng));
+    add_room_walls(b.scene, V2(-2.f, -2.4f), V2(end + 0.1f, 2.4f), -total - 0.2f, 2.9f + total,
+                   wall_material(rng));
   } else {
     floor_and_room(b.scene, rng, V2(-2.f, -2.2f), V2(end + 0.1f, 2.2f));
   }
-  add_crate(b.scene, V3(0.8f, down ? 1.9f : -1.7f, 0.f), 0.2f, V3(0.5f, 0.4f, 0.45f), wood_material(rng), "clutter");
+  add_crate(b.scene, V3(0.8f, down ? 1.9f : -1.7f, 0.f), 0.2f, V3(0.5f, 0.4f, 0.45f), wood_material(rng),
+            "clutter");
   const int id = add_staircase(b.scene, p, rng);
   const StairSpec& st = b.scene.stairs[static_cast<std::size_t>(id)];
   float walker_y = 0.f;
@@ -77,7 +79,8 @@ void flight_walk(Rng& rng, const SynthOptions& o, PresetBuild& b, const FlightWa
   w.duration_s = static_cast<float>(t_cross1 + 2.5);
   w.distance = [=](double t) -> float {
     if (t < t_cross0)
-      return stop * smooth_ramp(static_cast<float>(t), static_cast<float>(t_walk0), static_cast<float>(t_walk1));
+      return stop *
+             smooth_ramp(static_cast<float>(t), static_cast<float>(t_walk0), static_cast<float>(t_walk1));
     double u = t - t_cross0;  // time walking on the flight
     if (t >= t_pause0) u -= std::min(t - t_pause0, pause_s);
     if (u < cross_s) return stop + (last - stop) * static_cast<float>(u / cross_s);
@@ -89,8 +92,9 @@ void flight_walk(Rng& rng, const SynthOptions& o, PresetBuild& b, const FlightWa
     float h = deg2rad(3.f) * static_cast<float>(std::sin(0.6 * t));
     if (turn && t >= t_pause0 && t <= t_pause1) {
       const float tt = static_cast<float>(t);
-      h += deg2rad(40.f) * (smooth_ramp(tt, static_cast<float>(t_pause0 + 0.2), static_cast<float>(t_pause0 + 0.9)) -
-                            smooth_ramp(tt, static_cast<float>(t_pause1 - 0.9), static_cast<float>(t_pause1 - 0.2)));
+      h += deg2rad(40.f) *
+           (smooth_ramp(tt, static_cast<float>(t_pause0 + 0.2), static_cast<float>(t_pause0 + 0.9)) -
+            smooth_ramp(tt, static_cast<float>(t_pause1 - 0.9), static_cast<float>(t_pause1 - 0.2)));
     }
     return h;
   };
@@ -128,12 +132,14 @@ const std::vector<PresetDef>& walk_defs() {
                  flight(StairKind::kAscending, 3, 0.5f, 0.7f)),
       flight_def("climb_8_steps", "walk ~2 m to an 8-step flight, climb it at 0.8-1.0 steps/s onto a landing",
                  flight(StairKind::kAscending, 8, 0.8f, 1.0f)),
-      flight_def("climb_14_steps", "walk ~2 m to a 14-step flight, climb it at 1.0-1.2 steps/s onto a landing",
+      flight_def("climb_14_steps",
+                 "walk ~2 m to a 14-step flight, climb it at 1.0-1.2 steps/s onto a landing",
                  flight(StairKind::kAscending, 14, 1.0f, 1.2f)),
       flight_def("climb_8_pause_turn",
                  "climb 8 steps at 0.7-0.9 steps/s, stopping on the middle one to look 40 deg left and back",
                  flight(StairKind::kAscending, 8, 0.7f, 0.9f, true)),
-      flight_def("climb_8_person", "climb 8 steps at 0.8-1.0 steps/s past a person standing at one side of the flight",
+      flight_def("climb_8_person",
+                 "climb 8 steps at 0.8-1.0 steps/s past a person standing at one side of the flight",
                  flight(StairKind::kAscending, 8, 0.8f, 1.0f, false, true)),
       flight_def("descend_3_steps", "walk ~2 m to the top of a 3-step flight, go down at 0.5-0.7 steps/s",
                  flight(StairKind::kDescending, 3, 0.5f, 0.7f)),
@@ -141,9 +147,10 @@ const std::vector<PresetDef>& walk_defs() {
                  flight(StairKind::kDescending, 8, 0.8f, 1.0f)),
       flight_def("descend_14_steps", "walk ~2 m to the top of a 14-step flight, go down at 1.0-1.2 steps/s",
                  flight(StairKind::kDescending, 14, 1.0f, 1.2f)),
-      flight_def("descend_8_pause_turn",
-                 "go down 8 steps at 0.7-0.9 steps/s, stopping on the middle one to look 40 deg left and back",
-                 flight(StairKind::kDescending, 8, 0.7f, 0.9f, true)),
+      flight_def(
+          "descend_8_pause_turn",
+          "go down 8 steps at 0.7-0.9 steps/s, stopping on the middle one to look 40 deg left and back",
+          flight(StairKind::kDescending, 8, 0.7f, 0.9f, true)),
       flight_def("descend_8_person",
                  "go down 8 steps at 0.8-1.0 steps/s past a person standing at one side of the flight",
                  flight(StairKind::kDescending, 8, 0.8f, 1.0f, false, true)),

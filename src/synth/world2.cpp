@@ -48,8 +48,8 @@ WalkerState chest_view_ahead(Rng& rng, const SynthOptions& o) {
 
 // A floor slab and four walls 2.7 m high around [lo, hi].
 void floor_and_walls(Scene& s, Rng& rng, const V2& lo, const V2& hi) {
-  s.add_box_world(V3(lo.x() - 1.f, lo.y() - 1.f, -0.2f), V3(hi.x() + 1.f, hi.y() + 1.f, 0.f), floor_material(rng),
-                  "floor");
+  s.add_box_world(V3(lo.x() - 1.f, lo.y() - 1.f, -0.2f), V3(hi.x() + 1.f, hi.y() + 1.f, 0.f),
+                  floor_material(rng), "floor");
   add_room_walls(s, lo, hi, 0.f, 2.7f, wall_material(rng));
 }
 
@@ -82,8 +82,8 @@ Material ground_material(Rng& rng) { return rng.chance(0.5f) ? concrete_material
 // +-0.3 m), indoors (a room around it; a descending flight's walls go down to its foot) or
 // outdoors (open ground, a facade far behind), and a view of it from `rig`, heading +-25 deg.
 // Returns the flight's index in the scene's stairs.
-int flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p, bool outdoor, float d_lo = 0.8f,
-                 float d_hi = 3.0f, const Rig& rig = kChest) {
+int flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p, bool outdoor,
+                 float d_lo = 0.8f, float d_hi = 3.0f, const Rig& rig = kChest) {
   const bool down = p.kind == StairKind::kDescending;
   const float d = rng.uniform(d_lo, d_hi), lat = rng.uniform(-0.3f, 0.3f);
   p.T_world_stair = stair_pose(d, lat, 0.f, down ? 0.f : p.riser_m);
@@ -102,7 +102,8 @@ int flight_ahead(Rng& rng, const SynthOptions& o, PresetBuild& b, StairParams p,
     id = add_staircase(b.scene, p, rng);  // the upper floor and the lower one with it
     const float total = N * p.riser_m;
     if (outdoor)
-      b.scene.add_box_world(V3(-3.5f, -6.f, -total - 0.3f), V3(-3.2f, 6.f, 3.f), wall_material(rng), "facade");
+      b.scene.add_box_world(V3(-3.5f, -6.f, -total - 0.3f), V3(-3.2f, 6.f, 3.f), wall_material(rng),
+                            "facade");
     else
       add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + N * p.tread_m + 5.f, 4.f), -total - 0.2f, 2.9f + total,
                      wall_material(rng));
@@ -152,8 +153,10 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     central_wall = rng.chance(0.6f);
     gap = central_wall ? rng.uniform(0.1f, 0.25f) : rng.uniform(0.05f, 0.4f);
     D = std::max(W, rng.uniform(0.9f, 1.6f));
-    if (s > 0.f) yhi = hw + gap + W;
-    else ylo = -(hw + gap + W);
+    if (s > 0.f)
+      yhi = hw + gap + W;
+    else
+      ylo = -(hw + gap + W);
   }
   const Material wall_m = wall_material(rng);
 
@@ -172,8 +175,8 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const int id_lo = add_staircase(b.scene, lo, rng);
   const float foot = static_cast<float>(n_lo - 1) * T;  // where the lower floor (its last tread) begins
   // The lower floor: the lower flight's last tread, under everything.
-  b.scene.add_box_in(lo.T_world_stair, V3(-hw - 4.f, -total_lo - 0.2f, -8.f), V3(hw + 4.f, -total_lo, foot + 6.f),
-                     floor_material(rng), "lower_floor", id_lo, n_lo);
+  b.scene.add_box_in(lo.T_world_stair, V3(-hw - 4.f, -total_lo - 0.2f, -8.f),
+                     V3(hw + 4.f, -total_lo, foot + 6.f), floor_material(rng), "lower_floor", id_lo, n_lo);
   // The landing: with nosings, its edge overhangs the first riser below it like the treads'.
   const Material land_m = floor_material(rng);
   if (nosing > 0.f) {
@@ -206,11 +209,13 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     for (float side : {-1.f, 1.f}) {
       const float y0 = side * hw, y1 = side * (hw + 0.12f);
       const float x1 = side == s ? std::max(0.f, D - W) : D + 0.12f;
-      b.scene.add_box_world(V3(-len_lo, std::min(y0, y1), -total_lo), V3(x1, std::max(y0, y1), top), wall_m, "wall");
+      b.scene.add_box_world(V3(-len_lo, std::min(y0, y1), -total_lo), V3(x1, std::max(y0, y1), top), wall_m,
+                            "wall");
     }
     b.scene.add_box_world(V3(D, std::min(-s * (hw + 0.12f), s * hw), -total_lo),
                           V3(D + 0.12f, std::max(-s * (hw + 0.12f), s * hw), top), wall_m, "wall");
-    b.scene.add_box_world(V3(-len_lo - 0.12f, -hw - 0.12f, -total_lo), V3(-len_lo, hw + 0.12f, top), wall_m, "wall");
+    b.scene.add_box_world(V3(-len_lo - 0.12f, -hw - 0.12f, -total_lo), V3(-len_lo, hw + 0.12f, top), wall_m,
+                          "wall");
   } else {
     const float yc = s * (W + gap);
     up.side_walls = false;
@@ -221,12 +226,14 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     const float far = std::max(len_lo, len_up) + 0.2f;
     if (central_wall) {
       const float y0 = s * hw, y1 = s * (hw + gap);
-      b.scene.add_box_world(V3(-far, std::min(y0, y1), -total_lo), V3(0.f, std::max(y0, y1), top), wall_m, "wall");
+      b.scene.add_box_world(V3(-far, std::min(y0, y1), -total_lo), V3(0.f, std::max(y0, y1), top), wall_m,
+                            "wall");
     }
     b.scene.add_box_world(V3(-far, ylo - 0.12f, -total_lo), V3(D + 0.12f, ylo, top), wall_m, "wall");
     b.scene.add_box_world(V3(-far, yhi, -total_lo), V3(D + 0.12f, yhi + 0.12f, top), wall_m, "wall");
     b.scene.add_box_world(V3(D, ylo, -total_lo), V3(D + 0.12f, yhi, top), wall_m, "wall");
-    b.scene.add_box_world(V3(-far - 0.12f, ylo - 0.12f, -total_lo), V3(-far, yhi + 0.12f, top), wall_m, "wall");
+    b.scene.add_box_world(V3(-far - 0.12f, ylo - 0.12f, -total_lo), V3(-far, yhi + 0.12f, top), wall_m,
+                          "wall");
   }
 
   // The view: on the landing, facing the upper or the lower flight, or turning towards it.
@@ -324,12 +331,13 @@ StairParams code_flight(Rng& rng, StairKind kind) {
 
 // Things left on a step (the heights the issue names, 10-40 cm): a pair of shoes or boots, a bag,
 // a box. `k_top` is the tread's height (frame B of the flight), [z_lo, z_hi] its free depth.
-void add_thing_on_tread(Scene& scene, Rng& rng, const Pose& T_wb, float hw, float k_top, float z_lo, float z_hi,
-                        bool against_hi) {
+void add_thing_on_tread(Scene& scene, Rng& rng, const Pose& T_wb, float hw, float k_top, float z_lo,
+                        float z_hi, bool against_hi) {
   if (z_hi - z_lo < 0.08f) return;
   const int kind = rng.integer(0, 2);
   // A box w wide (along the step) and dp deep, against one end of [lo, hi] (a gap of 0-3 cm).
-  auto place = [&](float w, float dp, float h, const Material& m, const char* label, float x, float lo, float hi) {
+  auto place = [&](float w, float dp, float h, const Material& m, const char* label, float x, float lo,
+                   float hi) {
     dp = std::min(dp, hi - lo);
     const float gap = std::min(rng.uniform(0.f, 0.03f), hi - lo - dp);
     const float z1 = against_hi ? hi - gap : lo + gap + dp;
@@ -401,7 +409,8 @@ void dressed_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
     const float half = 0.5f * p.width_m + rng.uniform(0.2f, 2.5f), end = d + top_end;
     floor_and_walls(b.scene, rng, V2(-3.f, -half - 0.5f), V2(end + 0.2f, half + 0.5f));
     id = add_staircase(b.scene, p, rng);
-    if (carpet) b.scene.add_box_world(V3(-3.f, -half - 0.5f, 0.f), V3(end + 0.2f, half + 0.5f, c), cm, "carpet");
+    if (carpet)
+      b.scene.add_box_world(V3(-3.f, -half - 0.5f, 0.f), V3(end + 0.2f, half + 0.5f, c), cm, "carpet");
   } else {
     id = add_staircase(b.scene, p, rng);
     add_room_walls(b.scene, V2(-3.f, -4.f), V2(d + static_cast<float>(N) * T + 5.f, 4.f),
@@ -412,8 +421,8 @@ void dressed_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   T_wb.translation() = p.T_world_stair * V3(0.f, down ? 0.f : -R, 0.f);
   const float rn = 0.015f + c;  // the bull nose's radius, round the 3 cm nosing slab's mid line
   auto nose = [&](float y_top, float z, float half_w) {
-    b.scene.add_cylinder(T_wb * V3(-half_w, y_top - 0.015f, z), T_wb * V3(half_w, y_top - 0.015f, z), rn, rn, cm,
-                         "carpet", 16);
+    b.scene.add_cylinder(T_wb * V3(-half_w, y_top - 0.015f, z), T_wb * V3(half_w, y_top - 0.015f, z), rn, rn,
+                         cm, "carpet", 16);
   };
   if (carpet && !down) {
     for (int k = 1; k <= N; ++k) {
@@ -432,11 +441,12 @@ void dressed_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
       b.scene.add_box_in(T_wb, V3(-hw, y, z0 - n), V3(hw, y + c, z0 + T - 0.015f), cm, "carpet", id, k);
       nose(y, z0 + T - 0.015f, hw);
     }
-    b.scene.add_box_in(T_wb, V3(-6.f, -total, top_z0 - n), V3(6.f, -total + c, top_z0 + 8.f), cm, "carpet", id, N);
+    b.scene.add_box_in(T_wb, V3(-6.f, -total, top_z0 - n), V3(6.f, -total + c, top_z0 + 8.f), cm, "carpet",
+                       id, N);
     if (p.side_walls)  // the upper floor beside the flight
       for (float sd : {-1.f, 1.f})
-        b.scene.add_box_in(T_wb, V3(sd > 0 ? hw : -6.f, 0.f, -0.015f), V3(sd > 0 ? 6.f : -hw, c, top_z0 + 4.f), cm,
-                           "carpet");
+        b.scene.add_box_in(T_wb, V3(sd > 0 ? hw : -6.f, 0.f, -0.015f),
+                           V3(sd > 0 ? 6.f : -hw, c, top_z0 + 4.f), cm, "carpet");
   }
   if (carpet) {  // the labels: every level is c higher, the first edge is the bull nose's front
     StairSpec& sp = b.scene.stairs[static_cast<std::size_t>(id)];
@@ -453,11 +463,11 @@ void dressed_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
       const float z0 = static_cast<float>(k - 1) * T;
       for (int q = 0, per = rng.integer(1, 2); q < per; ++q) {
         if (!down)  // from the nose to the next riser, against the riser
-          add_thing_on_tread(b.scene, rng, T_wb, hw, static_cast<float>(k) * R + c, z0 + 0.03f + c, z0 + T + n - c,
-                             true);
+          add_thing_on_tread(b.scene, rng, T_wb, hw, static_cast<float>(k) * R + c, z0 + 0.03f + c,
+                             z0 + T + n - c, true);
         else  // from the riser above to the nose, against the riser
-          add_thing_on_tread(b.scene, rng, T_wb, hw, -static_cast<float>(k) * R + c, z0 - n, z0 + T - 0.03f - c,
-                             false);
+          add_thing_on_tread(b.scene, rng, T_wb, hw, -static_cast<float>(k) * R + c, z0 - n,
+                             z0 + T - 0.03f - c, false);
       }
     }
   }
@@ -479,7 +489,8 @@ void add_wearer_legs(Scene& scene, Rng& rng, const V3& body, float yaw, float ca
   const float hip_z = 0.74f * camera_h, spread = rng.uniform(0.15f, 0.30f), ahead = rng.uniform(0.f, 0.45f);
   const float lead = rng.chance(0.5f) ? 1.f : -1.f;  // the foot ahead: left or right
   const float r_thigh = rng.uniform(0.07f, 0.09f), r_shank = rng.uniform(0.05f, 0.06f);
-  const float len = rng.uniform(0.26f, 0.31f), wid = rng.uniform(0.09f, 0.11f), hgt = rng.uniform(0.07f, 0.11f);
+  const float len = rng.uniform(0.26f, 0.31f), wid = rng.uniform(0.09f, 0.11f),
+              hgt = rng.uniform(0.07f, 0.11f);
   for (float side : {-1.f, 1.f}) {
     // The ankle 5 cm ahead of the heel; the foot ahead reaches `ahead` further, the other as far
     // back.
@@ -491,8 +502,10 @@ void add_wearer_legs(Scene& scene, Rng& rng, const V3& body, float yaw, float ca
     scene.add_cylinder(knee, ankle, r_shank, r_shank, trousers, "wearer_leg", 10);
     const float toe_out = deg2rad(rng.uniform(0.f, 15.f)) * side;
     const float fy = yaw + toe_out;
-    const V3 heel = body + a * fwd + side * 0.5f * spread * left - 0.05f * V3(std::cos(fy), std::sin(fy), 0.f);
-    scene.add_box_in(yaw_frame(heel, fy), V3(0.f, -0.5f * wid, 0.f), V3(len, 0.5f * wid, hgt), shoe, "wearer_foot");
+    const V3 heel =
+        body + a * fwd + side * 0.5f * spread * left - 0.05f * V3(std::cos(fy), std::sin(fy), 0.f);
+    scene.add_box_in(yaw_frame(heel, fy), V3(0.f, -0.5f * wid, 0.f), V3(len, 0.5f * wid, hgt), shoe,
+                     "wearer_foot");
   }
 }
 
@@ -507,7 +520,8 @@ void legs_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   b.view = view_at(rng, o, V3::Zero(), 0.f, rig);
   const float h = b.view.T_world_camera.translation().z();
   add_wearer_legs(b.scene, rng, V3::Zero(), 0.f, h);
-  const float gap = rng.uniform(0.02f, 1.0f), lat = rng.uniform(-0.2f, 0.2f), psi = deg2rad(rng.uniform(-15.f, 15.f));
+  const float gap = rng.uniform(0.02f, 1.0f), lat = rng.uniform(-0.2f, 0.2f),
+              psi = deg2rad(rng.uniform(-15.f, 15.f));
   // The first edge `gap` beyond the foremost point of either shoe, measured along the flight.
   const V3 n(std::cos(psi), std::sin(psi), 0.f);
   float d = 0.f;
@@ -545,7 +559,8 @@ void lowrig_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   }
   const bool down = p.kind == StairKind::kDescending;
   b.view = view_at(rng, o, V3::Zero(), deg2rad(rng.uniform(-25.f, 25.f)), Rig{0.5f, 0.8f, 15.f, 60.f});
-  const float h = b.view.T_world_camera.translation().z(), tilt = std::max(0.2f, pose_tilt(b.view.T_world_camera));
+  const float h = b.view.T_world_camera.translation().z(),
+              tilt = std::max(0.2f, pose_tilt(b.view.T_world_camera));
   const float d = std::clamp(rng.uniform(0.4f, 1.2f) * h / std::tan(tilt), 0.3f, 3.0f);
   const float yaw = b.view.yaw + deg2rad(rng.uniform(-10.f, 10.f)), lat = rng.uniform(-0.2f, 0.2f);
   const V3 at = d * V3(std::cos(b.view.yaw), std::sin(b.view.yaw), 0.f) +
@@ -576,33 +591,40 @@ PresetDef def(const char* name, const char* summary, Fn fn) {
 const std::vector<PresetDef>& world2_defs() {
   static const std::vector<PresetDef> defs = {
       def("world2_turn_static",
-          "L- and U-shaped stairs seen from their landing: the flight up rising to the side, the flight down, the "
+          "L- and U-shaped stairs seen from their landing: the flight up rising to the side, the flight "
+          "down, the "
           "wearer facing one or turning to it (both labelled; codes' riser and going)",
           turn_static),
       def("world2_low_static",
-          "low-riser flights up or down: risers 8-12 cm, goings 30-60 cm, any 2R+T (training stairs, garden steps)",
+          "low-riser flights up or down: risers 8-12 cm, goings 30-60 cm, any 2R+T (training stairs, garden "
+          "steps)",
           low_static),
-      def("world2_steep_static", "steep flights up or down: goings 20-24 cm, risers 18-25 cm, narrow", steep_static),
+      def("world2_steep_static", "steep flights up or down: goings 20-24 cm, risers 18-25 cm, narrow",
+          steep_static),
       def("world2_dressed_static",
-          "carpeted flights (bull-nosed, pile relief) and shoes, bags and boxes (10-40 cm) on 1-3 treads, up or down",
+          "carpeted flights (bull-nosed, pile relief) and shoes, bags and boxes (10-40 cm) on 1-3 treads, up "
+          "or down",
           dressed_static),
       def("world2_legs_static",
-          "the wearer's own legs and feet at the bottom of a steep view (tilt 50-80 deg) before a flight up or down",
+          "the wearer's own legs and feet at the bottom of a steep view (tilt 50-80 deg) before a flight up "
+          "or down",
           legs_static),
-      def("world2_lowrig_static", "a waist or hip camera (0.5-0.8 m, tilt 15-60 deg) before a flight up or down",
-          lowrig_static),
-      def("world2_shelves_static", "bookcases and shelving 0.8-2.0 m high, boards every 25-40 cm, ladder shelves; no stairs",
+      def("world2_lowrig_static",
+          "a waist or hip camera (0.5-0.8 m, tilt 15-60 deg) before a flight up or down", lowrig_static),
+      def("world2_shelves_static",
+          "bookcases and shelving 0.8-2.0 m high, boards every 25-40 cm, ladder shelves; no stairs",
           shelves_static),
-      def("world2_boxes_static", "2-3 stacked boxes, each smaller than the one below (a stair of boxes); no stairs",
-          boxes_static),
-      def("world2_sofa_static", "a sofa (seat 38-48 cm, back 75-95 cm) with a coffee table or ottoman; no stairs",
-          sofa_static),
-      def("world2_bench_static", "a bench 40-50 cm high (slab, block or shoe bench with a low shelf); no stairs",
-          bench_static),
-      def("world2_lowtable_static", "a low table 35-50 cm (legs, block or a low shelf), rugs, nesting tables; no stairs",
+      def("world2_boxes_static",
+          "2-3 stacked boxes, each smaller than the one below (a stair of boxes); no stairs", boxes_static),
+      def("world2_sofa_static",
+          "a sofa (seat 38-48 cm, back 75-95 cm) with a coffee table or ottoman; no stairs", sofa_static),
+      def("world2_bench_static",
+          "a bench 40-50 cm high (slab, block or shoe bench with a low shelf); no stairs", bench_static),
+      def("world2_lowtable_static",
+          "a low table 35-50 cm (legs, block or a low shelf), rugs, nesting tables; no stairs",
           lowtable_static),
-      def("world2_bed_static", "a bed (mattress top 30-65 cm), headboard, a bench at the foot on some; no stairs",
-          bed_static),
+      def("world2_bed_static",
+          "a bed (mattress top 30-65 cm), headboard, a bench at the foot on some; no stairs", bed_static),
   };
   return defs;
 }

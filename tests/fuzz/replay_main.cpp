@@ -43,10 +43,35 @@ struct Rng {
   std::size_t below(std::size_t n) { return n ? static_cast<std::size_t>(next() % n) : 0; }
 };
 
-const char* const kTokens[] = {"\0",   "\xff",  "-1",   "0",      "1e300", "-1e300", "nan", "inf",
-                               ":",    "\n",    " ",    "[",      "]",     "{",      "}",   ",",
-                               "- ",   "&a",    "*a",   "!!str ", "---\n", "...",    "\"",  "'",
-                               "4294967296", "18446744073709551615", "SIZE ", "COUNT ", "DATA binary_compressed\n"};
+const char* const kTokens[] = {"\0",
+                               "\xff",
+                               "-1",
+                               "0",
+                               "1e300",
+                               "-1e300",
+                               "nan",
+                               "inf",
+                               ":",
+                               "\n",
+                               " ",
+                               "[",
+                               "]",
+                               "{",
+                               "}",
+                               ",",
+                               "- ",
+                               "&a",
+                               "*a",
+                               "!!str ",
+                               "---\n",
+                               "...",
+                               "\"",
+                               "'",
+                               "4294967296",
+                               "18446744073709551615",
+                               "SIZE ",
+                               "COUNT ",
+                               "DATA binary_compressed\n"};
 
 Bytes mutate(Bytes b, Rng& r, const std::vector<Bytes>& corpus) {
   const int ops = 1 + static_cast<int>(r.below(4));
@@ -67,7 +92,8 @@ Bytes mutate(Bytes b, Rng& r, const std::vector<Bytes>& corpus) {
       case 3: {  // repeat a range
         if (b.empty() || b.size() > (1u << 20)) break;
         const std::size_t at = r.below(b.size()), n = 1 + r.below(std::min<std::size_t>(b.size() - at, 64));
-        const Bytes piece(b.begin() + static_cast<std::ptrdiff_t>(at), b.begin() + static_cast<std::ptrdiff_t>(at + n));
+        const Bytes piece(b.begin() + static_cast<std::ptrdiff_t>(at),
+                          b.begin() + static_cast<std::ptrdiff_t>(at + n));
         b.insert(b.begin() + static_cast<std::ptrdiff_t>(r.below(b.size() + 1)), piece.begin(), piece.end());
         break;
       }

@@ -112,7 +112,7 @@ class DatasetSource : public FrameSource {
   DatasetCamera camera_;
   std::vector<Pair> pairs_;
   std::vector<TimedPose> groundtruth_;
-  std::vector<FrameTruth> labels_;  ///< sorted by timestamp
+  std::vector<FrameTruth> labels_;          ///< sorted by timestamp
   std::optional<FrameTruth> folder_label_;  ///< a whole-folder labels.yaml (read_folder_label_yaml)
   long skipped_ = 0;
   long next_ = 0;

@@ -28,7 +28,7 @@ PipelineConfig load_config(const std::string& path, ConfigLoadReport* report = n
 
 /// Same, from text; `name` stands for the file name in messages.
 PipelineConfig load_config_text(const std::string& text, const std::string& name,
-                                 ConfigLoadReport* report = nullptr);
+                                ConfigLoadReport* report = nullptr);
 
 /// The config as commented YAML in file units; loading it gives back an equal config.
 std::string dump_config_yaml(const PipelineConfig& config);

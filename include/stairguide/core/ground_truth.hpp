@@ -27,23 +27,23 @@ bool parse_stair_kind(const std::string& s, StairKind& out);
 
 /// One staircase (or single step / curb) of a scene, as seen in one frame.
 struct StairTruth {
-  int id = 0;                        ///< index of the staircase in the scene
+  int id = 0;  ///< index of the staircase in the scene
   StairKind kind = StairKind::kNone;
-  int steps = 0;                     ///< number of risers
-  float riser_m = 0.f;               ///< m, vertical distance between consecutive treads
-  float tread_m = 0.f;               ///< m, horizontal distance edge to edge
-  float width_m = 0.f;               ///< m
+  int steps = 0;        ///< number of risers
+  float riser_m = 0.f;  ///< m, vertical distance between consecutive treads
+  float tread_m = 0.f;  ///< m, horizontal distance edge to edge
+  float width_m = 0.f;  ///< m
   bool open_risers = false;
   /// A curb: the ground beyond its edge is lower than the user's floor (a curb down taken for a
   /// step up is a fall, and the kind alone cannot say which way a curb goes). For the other kinds
   /// the kind says it; use goes_down().
   bool down = false;
   Pose T_camera_stair = Pose::Identity();  ///< stair frame S into camera frame C
-  std::vector<int> visible_steps;    ///< 1-based indices of treads with >= 200 visible pixels
-  std::vector<int> visible_pixels;   ///< visible tread pixels, one per entry of visible_steps
-  bool first_edge_visible = false;   ///< the first step's edge is in view (not occluded)
-  bool both_ends_visible = false;    ///< both ends of the first edge are in view (width measurable)
-  int user_step = 0;                 ///< tread the user stands on: 0 = floor before it, k = step k
+  std::vector<int> visible_steps;          ///< 1-based indices of treads with >= 200 visible pixels
+  std::vector<int> visible_pixels;         ///< visible tread pixels, one per entry of visible_steps
+  bool first_edge_visible = false;         ///< the first step's edge is in view (not occluded)
+  bool both_ends_visible = false;          ///< both ends of the first edge are in view (width measurable)
+  int user_step = 0;                       ///< tread the user stands on: 0 = floor before it, k = step k
 
   /// The surface beyond the first edge is lower than the user's floor: descending, or a curb down.
   bool goes_down() const { return kind == StairKind::kDescending || (kind == StairKind::kCurb && down); }
@@ -52,14 +52,14 @@ struct StairTruth {
 /// Ground truth of one frame.
 struct FrameTruth {
   std::uint64_t index = 0;
-  double timestamp = 0.0;           ///< s
-  std::string scene;                ///< preset name
+  double timestamp = 0.0;                  ///< s
+  std::string scene;                       ///< preset name
   Pose T_world_camera = Pose::Identity();  ///< world: z up, origin on the floor
-  float camera_height_m = 0.f;      ///< m above the floor the user stands on
-  float camera_tilt_rad = 0.f;      ///< rad, optical axis below horizontal
-  float camera_roll_rad = 0.f;      ///< rad
-  bool floor_visible = false;       ///< >= 5% of pixels see the floor the user stands on
-  std::vector<StairTruth> stairs;   ///< staircases in the scene (visible or not)
+  float camera_height_m = 0.f;             ///< m above the floor the user stands on
+  float camera_tilt_rad = 0.f;             ///< rad, optical axis below horizontal
+  float camera_roll_rad = 0.f;             ///< rad
+  bool floor_visible = false;              ///< >= 5% of pixels see the floor the user stands on
+  std::vector<StairTruth> stairs;          ///< staircases in the scene (visible or not)
   /// Pixels of the most visible wall or riser face (a vertical face of a wall, a riser or a step,
   /// at least 8 cm tall, within range, where the depth sensor gives a reading): what the
   /// Manhattan frame is built from. 0 for dataset frames.

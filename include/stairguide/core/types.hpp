@@ -13,12 +13,12 @@ namespace stairguide {
 
 /// Pinhole intrinsics of the depth image (colour is registered to depth).
 struct CameraIntrinsics {
-  int width = 640;   ///< px
-  int height = 480;  ///< px
-  float fx = 525.f;  ///< px
-  float fy = 525.f;  ///< px
-  float cx = 319.5f; ///< px
-  float cy = 239.5f; ///< px
+  int width = 640;    ///< px
+  int height = 480;   ///< px
+  float fx = 525.f;   ///< px
+  float fy = 525.f;   ///< px
+  float cx = 319.5f;  ///< px
+  float cy = 239.5f;  ///< px
 
   /// Intrinsics for an image scaled by `s` (e.g. 0.5 for the next pyramid level).
   CameraIntrinsics scaled(float s) const;

@@ -44,15 +44,15 @@ const char* to_string(EvalOutcome o);
 
 struct StairFrameEval {
   EvalOutcome outcome = EvalOutcome::kTN;
-  bool false_positive = false;      ///< also true for an FN frame with a detection somewhere else
+  bool false_positive = false;                  ///< also true for an FN frame with a detection somewhere else
   StairKind truth_kind = StairKind::kNone;      ///< kind of the matched (or main visible) truth stair
   StairKind predicted_kind = StairKind::kNone;  ///< kNone when nothing was detected
-  bool truth_down = false;          ///< StairTruth::goes_down() of that truth stair
-  int predicted_direction = 0;      ///< StairResult::direction() of the detection, 0 when none
-  bool wrong_direction = false;     ///< a detection at a true stair's edge but going the other way
+  bool truth_down = false;                      ///< StairTruth::goes_down() of that truth stair
+  int predicted_direction = 0;                  ///< StairResult::direction() of the detection, 0 when none
+  bool wrong_direction = false;  ///< a detection at a true stair's edge but going the other way
   int truth_visible_steps = 0;
-  bool fully_visible = false;       ///< an expected stair whose first edge is in view with both ends
-  bool on_stairs = false;           ///< the user stands on a step (not scored: traversal's frames)
+  bool fully_visible = false;  ///< an expected stair whose first edge is in view with both ends
+  bool on_stairs = false;      ///< the user stands on a step (not scored: traversal's frames)
   int predicted_levels = 0;
   StairVerdict verdict = StairVerdict::kNoCandidates;  ///< the stage's verdict (why not, or kDetected)
   bool has_riser = false, has_tread = false, has_width = false, has_edge = false, has_edge_line = false;
@@ -100,8 +100,8 @@ struct ErrorStats {
 /// Counts and error statistics over many frames.
 struct EvalSummary {
   int frames = 0, tp = 0, fp = 0, tn = 0, fn = 0, skipped = 0;
-  int kind_correct = 0;  ///< TPs whose predicted kind equals the truth kind (a curb's direction too)
-  int kind_ok = 0;       ///< TPs whose kind is right for the user (StairFrameEval::kind_ok)
+  int kind_correct = 0;     ///< TPs whose predicted kind equals the truth kind (a curb's direction too)
+  int kind_ok = 0;          ///< TPs whose kind is right for the user (StairFrameEval::kind_ok)
   int wrong_direction = 0;  ///< frames with a detection at a true edge going the wrong way
   /// Scored (not skipped) frames by truth label then reported label (kind_label; "none" when
   /// nothing was detected or no stair was in view).
@@ -109,12 +109,15 @@ struct EvalSummary {
   /// The table of why-nots: scored frames by outcome ("tp", "fn", "fp", "tn") then the stage's
   /// verdict (to_string(StairVerdict)), so a miss is counted with the reason the software gave.
   std::map<std::string, std::map<std::string, int>> verdicts;
-  int full_tp = 0, full_fn = 0;  ///< TP / FN among frames whose stair is fully visible (first edge, both ends)
+  int full_tp = 0,
+      full_fn = 0;  ///< TP / FN among frames whose stair is fully visible (first edge, both ends)
   ErrorStats riser, tread, width, edge_pos, edge_line, yaw;
   void add(const StairFrameEval& e);
   double precision() const { return tp + fp ? static_cast<double>(tp) / (tp + fp) : 1.0; }
   double recall() const { return tp + fn ? static_cast<double>(tp) / (tp + fn) : 1.0; }
-  double recall_fully_visible() const { return full_tp + full_fn ? static_cast<double>(full_tp) / (full_tp + full_fn) : 1.0; }
+  double recall_fully_visible() const {
+    return full_tp + full_fn ? static_cast<double>(full_tp) / (full_tp + full_fn) : 1.0;
+  }
 };
 
 /// A summary overall, by truth kind and by scene (preset) name.
@@ -136,15 +139,15 @@ struct StairEvalTable {
 /// Drop-offs (issue 42 item 4) told per frame, scored against the synthetic truth's drop_* fields.
 struct DropEvalSummary {
   int frames = 0;
-  int near = 0, near_told = 0;        ///< a drop in view within DropEvalTable::near_m, and of them told
-  int near_no_floor = 0;              ///< ... of the near ones missed, those where perception found no floor
-  int far = 0, far_told = 0;          ///< a drop in view beyond it (within reach of the sensor or not)
-  int none = 0, none_told = 0;        ///< no drop in the scene (and no descent in view): told is a false alarm
-  int hidden = 0, hidden_told = 0;    ///< a drop in the scene but too little of its edge in view
+  int near = 0, near_told = 0;      ///< a drop in view within DropEvalTable::near_m, and of them told
+  int near_no_floor = 0;            ///< ... of the near ones missed, those where perception found no floor
+  int far = 0, far_told = 0;        ///< a drop in view beyond it (within reach of the sensor or not)
+  int none = 0, none_told = 0;      ///< no drop in the scene (and no descent in view): told is a false alarm
+  int hidden = 0, hidden_told = 0;  ///< a drop in the scene but too little of its edge in view
   /// A descending staircase (or step down) in view: told as a drop; a drop found there that the
   /// stair cue took over (DropSummary::by_stairs).
   int descent = 0, descent_told = 0, descent_by_stairs = 0;
-  ErrorStats distance, bearing_deg;   ///< of the near frames told: m and deg, told minus truth
+  ErrorStats distance, bearing_deg;  ///< of the near frames told: m and deg, told minus truth
   double near_rate() const { return near ? static_cast<double>(near_told) / near : 1.0; }
 };
 
@@ -152,7 +155,8 @@ struct DropEvalTable {
   float near_m = 2.f;  ///< m, the edge within this of the wearer: must be told
   DropEvalSummary all;
   std::map<std::string, DropEvalSummary> by_scene;
-  void add(const DropSummary& told, const FrameTruth& truth, const std::string& scene, bool floor_found = true);
+  void add(const DropSummary& told, const FrameTruth& truth, const std::string& scene,
+           bool floor_found = true);
   std::string to_json() const;  ///< one object: the overall counts and by_scene
   std::string to_text() const;  ///< a table, one line per scene with any frame of interest
 };

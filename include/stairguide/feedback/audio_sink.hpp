@@ -48,11 +48,11 @@ struct Utterance {
   std::vector<std::string> clips;  ///< sound bank names, played back to back
   std::string label;               ///< for logs ("stairs_ahead_up:3m")
   Delivery delivery = Delivery::kQueue;
-  std::uint32_t kinds = 0;         ///< what it says, as a bit set of the caller's numbering
-  std::uint32_t supersedes = 0;    ///< kinds it makes stale (waiting: dropped; speaking: cut)
+  std::uint32_t kinds = 0;            ///< what it says, as a bit set of the caller's numbering
+  std::uint32_t supersedes = 0;       ///< kinds it makes stale (waiting: dropped; speaking: cut)
   std::vector<std::string> fallback;  ///< kCut outranked: this earcon is mixed instead (empty: waits)
-  float pan = 0.f;                 ///< -1 left .. 0 centre .. +1 right (stereo output only)
-  double max_wait_s = -1.0;        ///< s it may wait before it is stale; < 0: the sink's max_age_s
+  float pan = 0.f;                    ///< -1 left .. 0 centre .. +1 right (stereo output only)
+  double max_wait_s = -1.0;           ///< s it may wait before it is stale; < 0: the sink's max_age_s
   SteadyClock::time_point queued{};
 };
 
@@ -138,7 +138,7 @@ class AlsaAudioSink : public AudioSink {
     std::uint64_t fallbacks = 0;   ///< kCut utterances told by their earcon over a higher phrase
     std::uint64_t underruns = 0, open_failures = 0;
     bool device_open = false;
-    int channels = 0;  ///< of the open device (0 closed)
+    int channels = 0;       ///< of the open device (0 closed)
     bool realtime = false;  ///< the thread got real-time scheduling
   };
   Counters counters() const;
@@ -171,7 +171,7 @@ class AlsaAudioSink : public AudioSink {
   std::deque<Utterance> queue_;
   std::vector<Voice> speech_;  // at most one phrase speaking
   std::vector<Voice> mix_;     // earcons sounding over it
-  bool open_ = false;      // pcm_ open (read by play() under m_)
+  bool open_ = false;          // pcm_ open (read by play() under m_)
   int channels_ = 1;
   bool stop_ = false;
   SteadyClock::time_point stop_deadline_{};

@@ -13,21 +13,21 @@
 namespace stairguide::feedback {
 
 enum class Cue {
-  kReady,        ///< the pipeline is running
-  kCameraLost,   ///< the camera stopped sending
-  kCameraBack,   ///< the camera is back
-  kBlind,        ///< frames come, but neither floor nor stair is seen: "cannot see"
-  kStairsAhead,  ///< a staircase ahead, `direction`, `number` metres (-1 unknown), `clock`
-  kDropWarning,  ///< a descending staircase near (or of unknown distance): always told
-  kStepAhead,    ///< a single step or a curb ahead (`kind`), `direction`
-  kFirstStep,    ///< on the first step of a flight
-  kTick,         ///< one more step climbed or descended
-  kCount,        ///< steps so far on the flight (`number`), said every count_interval steps
-  kStepsLeft,    ///< steps still to go (`number`)
-  kLastStep,     ///< the next step (or the one underfoot) is the last
-  kEndOfStairs,  ///< off the flight, on the new floor
-  kApproach,     ///< the approach beep: a descending first edge within approach range, repeated
-                 ///< faster as it nears (`distance_m`)
+  kReady,            ///< the pipeline is running
+  kCameraLost,       ///< the camera stopped sending
+  kCameraBack,       ///< the camera is back
+  kBlind,            ///< frames come, but neither floor nor stair is seen: "cannot see"
+  kStairsAhead,      ///< a staircase ahead, `direction`, `number` metres (-1 unknown), `clock`
+  kDropWarning,      ///< a descending staircase near (or of unknown distance): always told
+  kStepAhead,        ///< a single step or a curb ahead (`kind`), `direction`
+  kFirstStep,        ///< on the first step of a flight
+  kTick,             ///< one more step climbed or descended
+  kCount,            ///< steps so far on the flight (`number`), said every count_interval steps
+  kStepsLeft,        ///< steps still to go (`number`)
+  kLastStep,         ///< the next step (or the one underfoot) is the last
+  kEndOfStairs,      ///< off the flight, on the new floor
+  kApproach,         ///< the approach beep: a descending first edge within approach range, repeated
+                     ///< faster as it nears (`distance_m`)
   kBatteryLow,       ///< the laptop's battery is low (`number`: percent), not charging
   kBatteryCritical,  ///< ... critically low: the daemon will soon stop
   kSlow,             ///< perception has fallen behind the camera for long enough to matter

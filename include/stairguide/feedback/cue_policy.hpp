@@ -65,12 +65,12 @@ Verbosity parse_verbosity(const std::string& s);
 
 /// What the policy reads of one perceived frame.
 struct CueInput {
-  double t = 0.0;             ///< s, the frame's timestamp (monotonic within a run)
-  bool floor_found = false;   ///< the floor is seen in this frame
-  StairSummary stair;         ///< this frame's detection
-  TraversalResult traversal;  ///< the tracker's state (`ran` false: detection cues only)
-  DropSummary drop;           ///< this frame's drop-off (not told when the stair stage tells a descent)
-  double lag_s = 0.0;         ///< s from the frame's capture to this decision (perception behind)
+  double t = 0.0;              ///< s, the frame's timestamp (monotonic within a run)
+  bool floor_found = false;    ///< the floor is seen in this frame
+  StairSummary stair;          ///< this frame's detection
+  TraversalResult traversal;   ///< the tracker's state (`ran` false: detection cues only)
+  DropSummary drop;            ///< this frame's drop-off (not told when the stair stage tells a descent)
+  double lag_s = 0.0;          ///< s from the frame's capture to this decision (perception behind)
   std::vector<Press> presses;  ///< the wearer's button presses since the last decision, in order
 };
 
@@ -153,19 +153,19 @@ class CuePolicy {
   double last_tick_t_ = -1e9;
   // Approach beep (to a descending first edge).
   struct Approach {
-    bool on = false;             // within range, ahead, walking: beeping
+    bool on = false;  // within range, ahead, walking: beeping
     double last_beep_t = -1e9;
-    float nearest = 0.f;         // m, the nearest (filtered) distance of this approach
-    float ref_d = 0.f;           // m, distance when the wearer last came 0.15 m nearer ...
-    double ref_t = 0.0;          // ... and when
-    float recent[5] = {};        // the last distances, for the median
+    float nearest = 0.f;   // m, the nearest (filtered) distance of this approach
+    float ref_d = 0.f;     // m, distance when the wearer last came 0.15 m nearer ...
+    double ref_t = 0.0;    // ... and when
+    float recent[5] = {};  // the last distances, for the median
     int n_recent = 0;
   };
   Approach approach_;
   // A drop-off: confirmed (as a staircase is), held until forgotten, warned of once while held.
   struct DropHold {
     bool active = false, warned = false;
-    int frames = 0;                   // confirming sightings
+    int frames = 0;                       // confirming sightings
     double first_t = 0.0, last_t = -1e9;  // of the candidate's sightings
     double last_seen_t = -1e9;
   };

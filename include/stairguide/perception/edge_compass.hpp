@@ -31,13 +31,16 @@
 namespace stairguide {
 
 struct EdgeCompassConfig {
-  int stride = 2;                  ///< px of the half-resolution image: every stride-th pixel in each direction votes
-  int window = 5;                  ///< px of the half-resolution image: the structure tensor's window
-  float min_gradient = 6.f;        ///< grey levels per pixel (RMS over the window), weaker edges are noise
-  float min_coherence = 0.7f;      ///< of the structure tensor: 1 on a straight edge, 0 on isotropic texture
-  float min_horizontal = 0.26f;    ///< sin of the angle between the interpretation plane and the vertical (15 deg): closer, the edge may be vertical
-  float peak_halfwidth = 0.0349f;  ///< rad, votes within this of the peak refine it and count as its support (2 deg)
-  float line_min_length = 150.f;   ///< px of the full image: collinear segments adding up to this make a long edge (EdgeCompassResult::lines); 0: none
+  int stride = 2;  ///< px of the half-resolution image: every stride-th pixel in each direction votes
+  int window = 5;  ///< px of the half-resolution image: the structure tensor's window
+  float min_gradient = 6.f;      ///< grey levels per pixel (RMS over the window), weaker edges are noise
+  float min_coherence = 0.7f;    ///< of the structure tensor: 1 on a straight edge, 0 on isotropic texture
+  float min_horizontal = 0.26f;  ///< sin of the angle between the interpretation plane and the vertical (15
+                                 ///< deg): closer, the edge may be vertical
+  float peak_halfwidth =
+      0.0349f;  ///< rad, votes within this of the peak refine it and count as its support (2 deg)
+  float line_min_length = 150.f;  ///< px of the full image: collinear segments adding up to this make a long
+                                  ///< edge (EdgeCompassResult::lines); 0: none
 };
 
 /// A long straight edge: collinear line segments of the image chained along one line.
@@ -45,15 +48,18 @@ struct EdgeLine {
   float heading = 0.f;  ///< rad, modulo 90 degrees in (-45, 45]: its horizontal direction in the floor frame
   float length = 0.f;   ///< px of the full image: the segments' summed length along it
   float span = 0.f;     ///< px of the full image: from its first segment's end to its last's
-  Eigen::Vector2f a = Eigen::Vector2f::Zero(), b = Eigen::Vector2f::Zero();  ///< px of the full image: its two ends
+  Eigen::Vector2f a = Eigen::Vector2f::Zero(),
+                  b = Eigen::Vector2f::Zero();  ///< px of the full image: its two ends
 };
 
 struct EdgeCompassResult {
   bool valid = false;
-  float yaw = 0.f;        ///< rad, modulo 90 degrees in (-45, 45]: the dominant horizontal direction in the floor frame (heading from z_F towards x_F)
-  float support = 0.f;    ///< share of the voting weight within peak_halfwidth of `yaw` (a uniform spread gives 2 * halfwidth / 90 deg)
-  float weight = 0.f;     ///< total voting weight (edge strength x straightness x horizontal share, summed)
-  int edgels = 0;         ///< pixels that voted
+  float yaw = 0.f;  ///< rad, modulo 90 degrees in (-45, 45]: the dominant horizontal direction in the floor
+                    ///< frame (heading from z_F towards x_F)
+  float support = 0.f;  ///< share of the voting weight within peak_halfwidth of `yaw` (a uniform spread gives
+                        ///< 2 * halfwidth / 90 deg)
+  float weight = 0.f;   ///< total voting weight (edge strength x straightness x horizontal share, summed)
+  int edgels = 0;       ///< pixels that voted
   std::vector<EdgeLine> lines;  ///< long straight edges (EdgeCompassConfig::line_min_length), longest first
 };
 
@@ -62,7 +68,8 @@ struct EdgeCompassResult {
 class EdgeCompass {
  public:
   explicit EdgeCompass(const EdgeCompassConfig& config = {}) : cfg_(config) {}
-  EdgeCompassResult estimate(const cv::Mat& gray, const CameraIntrinsics& K, const Eigen::Matrix3f& R_floor_camera);
+  EdgeCompassResult estimate(const cv::Mat& gray, const CameraIntrinsics& K,
+                             const Eigen::Matrix3f& R_floor_camera);
   /// As above, and the long straight edges that lie on the floor (EdgeCompassResult::lines), told
   /// by `depth` (CV_32FC1, metres, 0: no reading, registered to `gray`), the floor's pose and the
   /// depth cut-off `max_range` (m).
@@ -74,14 +81,14 @@ class EdgeCompass {
     float a, w;  // heading modulo 90 degrees (rad), weight
   };
   EdgeCompassConfig cfg_;
-  std::vector<float> hist_;  // scratch
-  std::vector<Vote> votes_;  // scratch
-  cv::Mat half_, gx_, gy_;   // scratch: half-resolution image and gradients
-  std::vector<float> rows_;  // scratch: per row, horizontal window sums of the structure tensor
-  std::vector<float> acc_;   // scratch: their vertical running sum
+  std::vector<float> hist_;      // scratch
+  std::vector<Vote> votes_;      // scratch
+  cv::Mat half_, gx_, gy_;       // scratch: half-resolution image and gradients
+  std::vector<float> rows_;      // scratch: per row, horizontal window sums of the structure tensor
+  std::vector<float> acc_;       // scratch: their vertical running sum
   std::vector<cv::Vec4f> segs_;  // scratch: line segments of the half-resolution image
-  void find_lines(const CameraIntrinsics& K, const Pose& T_floor_camera, const cv::Mat& depth, float max_range,
-                  EdgeCompassResult& out);
+  void find_lines(const CameraIntrinsics& K, const Pose& T_floor_camera, const cv::Mat& depth,
+                  float max_range, EdgeCompassResult& out);
   bool on_floor(const Eigen::Vector2f& p1, const Eigen::Vector2f& p2, const CameraIntrinsics& K,
                 const Pose& T_floor_camera, const cv::Mat& depth, float max_range) const;
 };

@@ -12,10 +12,11 @@
 /// floor). Once established the height is held: outside the usual band a floor is taken only
 /// within rig_height_tolerance of it, so a table, bed, seat or landing below the camera is never
 /// the floor; a height held within the band leaves the band's choice as it was (the traversal's
-/// drift correction depends on it) and keeps what lies outside the band from being the floor. When a fresh start would take a clear floor at one other height for rig_relearn_frames
-/// frames with none at the held height in between (the wearer sat down, the rig was remounted),
-/// that height is relearned; a floor lower than held only when no level lies in view between it
-/// and the camera (on a stair the treads nearer the camera are in view).
+/// drift correction depends on it) and keeps what lies outside the band from being the floor. When a fresh
+/// start would take a clear floor at one other height for rig_relearn_frames frames with none at the held
+/// height in between (the wearer sat down, the rig was remounted), that height is relearned; a floor lower
+/// than held only when no level lies in view between it and the camera (on a stair the treads nearer the
+/// camera are in view).
 ///  - it must be near the user: the search window on z_C starts at search_start and grows by
 ///    search_step up to search_max; the first window in which some candidate has min_area of
 ///    footprint wins, and among the candidates the one with the largest footprint in it.
@@ -52,8 +53,8 @@ namespace stairguide {
 /// The floor found in one frame.
 struct FloorEstimate {
   bool found = false;
-  std::string why;                    ///< when !found
-  int region = -1;                    ///< index of the floor region
+  std::string why;  ///< when !found
+  int region = -1;  ///< index of the floor region
   /// When !found: the plane the rules chose (a chest camera's orientation and height, the largest
   /// footprint near the user) and the checks then refused first for where it lies. It may be a
   /// tread or a seat, but its normal is still the vertical (perception measures the Manhattan
@@ -61,12 +62,12 @@ struct FloorEstimate {
   /// the real kitchen, worktop and floor patches too small to be chosen gave frames up to 9 deg
   /// off). When found, the floor's region.
   int level_region = -1;
-  bool tracked = false;               ///< chosen by agreement with the previous frame's floor
+  bool tracked = false;  ///< chosen by agreement with the previous frame's floor
   Eigen::Vector3f normal = -Eigen::Vector3f::UnitY();  ///< floor up direction, camera frame
-  float offset = 0.f;                 ///< n.p + offset = 0 for floor points; = camera height
-  float height = 0.f;                 ///< m
-  float tilt = 0.f;                   ///< rad
-  float roll = 0.f;                   ///< rad
+  float offset = 0.f;                                  ///< n.p + offset = 0 for floor points; = camera height
+  float height = 0.f;                                  ///< m
+  float tilt = 0.f;                                    ///< rad
+  float roll = 0.f;                                    ///< rad
   Pose T_floor_camera = Pose::Identity();
 };
 
@@ -122,7 +123,8 @@ class FloorDetector {
   int frames_since_floor() const { return prev_ ? lost_frames_ : -1; }
 
  private:
-  int choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k, bool& tracked);
+  int choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k,
+             bool& tracked);
   struct Reach {
     float distance = 1e9f;  // m from the camera's foot to the plane's near edge
     float angle = 1.6f;     // rad from the nadir to the plane's near edge
@@ -182,8 +184,9 @@ class FloorDetector {
   bool edge_end_at_border(const std::vector<Eigen::Vector2f>& edge, const Eigen::Vector2f& along, float t,
                           const Pose& T_floor_camera, float rise, int width, int height) const;
   std::vector<unsigned char> grid_;
-  std::vector<unsigned char> curb_grid_;                 // level_above_underfoot scratch: the grid grown along x
-  std::vector<Eigen::Vector2f> curb_u_, curb_edge_;      // ... the upper level's points and its edge with F (floor frame x, z)
+  std::vector<unsigned char> curb_grid_;  // level_above_underfoot scratch: the grid grown along x
+  std::vector<Eigen::Vector2f> curb_u_,
+      curb_edge_;  // ... the upper level's points and its edge with F (floor frame x, z)
   std::vector<float> lateral_;
   bool stack_below_ = false;  // middle_of_stack said so: every lower plane is a tread too
   CameraIntrinsics K_;

@@ -51,8 +51,8 @@ namespace stairguide {
 struct ManhattanEstimate {
   bool found = false;
   std::string why;
-  float yaw = 0.f;       ///< rad, k_M from z_F about y_F (positive towards x_F, the left)
-  float fraction = 0.f;  ///< share of planar area on vertical planes agreeing with the frame
+  float yaw = 0.f;            ///< rad, k_M from z_F about y_F (positive towards x_F, the left)
+  float fraction = 0.f;       ///< share of planar area on vertical planes agreeing with the frame
   float vertical_area = 0.f;  ///< m^2 of agreeing vertical planes
   Pose T_manhattan_floor = Pose::Identity();
 };
@@ -75,8 +75,8 @@ Eigen::Vector3f fit_upright_normal(const std::vector<Eigen::Vector3f>& pts, cons
 /// by reading, so that the choice does not depend on the noise; done twice. `n_upright` is returned
 /// unchanged unless at least half of the points (and 30) are clear. See manhattan_frame.cpp.
 Eigen::Vector3f fit_upright_normal_clear_of_cutoff(const std::vector<Eigen::Vector3f>& pts,
-                                                   const Eigen::Vector3f& up, const Eigen::Vector3f& n_upright,
-                                                   float clear_depth);
+                                                   const Eigen::Vector3f& up,
+                                                   const Eigen::Vector3f& n_upright, float clear_depth);
 
 /// k_M is the dominant direction closest to forward; near +-45 degrees both branches are about as
 /// close, so `yaw` is moved onto the branch of the `previous` k_M where that stays within 10
@@ -119,11 +119,13 @@ class ManhattanTracker {
   struct Vote {
     float a, w, area, width;
     float heading;  // the normal's direction in the floor plane, rad, (-pi, pi]
-    bool inside;    // the floor goes on beyond the plane (or it reaches below the floor): furniture, a riser, a person
+    bool inside;  // the floor goes on beyond the plane (or it reaches below the floor): furniture, a riser, a
+                  // person
     bool grounded;  // its lowest point is at the floor's height
     bool clipped;   // most of its points lie at the depth cut-off
     int region;     // index in the regions
-    bool sliver;    // clipped, and narrower than ManhattanConfig::sliver_width: its yaw may be off by 10 degrees
+    bool
+        sliver;  // clipped, and narrower than ManhattanConfig::sliver_width: its yaw may be off by 10 degrees
     // Its plane seen from above, normal towards the camera: a point (x, z) of the floor frame lies
     // beyond it by more than floor_beyond_margin when nx * x + nz * z < limit.
     bool has_side = false;
@@ -173,7 +175,8 @@ class ManhattanTracker {
   /// Sets Vote::riser and tread_depth (see manhattan_frame.cpp).
   void mark_risers(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
   /// The frame of the planes agreeing with the image edges' direction (see estimate()).
-  ManhattanEstimate confirm(const std::vector<Vote>& votes, float total_area, const EdgeCompassResult& compass) const;
+  ManhattanEstimate confirm(const std::vector<Vote>& votes, float total_area,
+                            const EdgeCompassResult& compass) const;
   /// The frame of a long straight edge on the floor that a wall agrees with (see estimate()).
   ManhattanEstimate confirm_by_lines(const std::vector<Vote>& votes, float total_area,
                                      const EdgeCompassResult& compass) const;
@@ -185,9 +188,9 @@ class ManhattanTracker {
   void sample_structure(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera);
   /// What vote_of needs of the floor's pose, computed once a frame.
   struct VoteView {
-    Eigen::Matrix3f R;        // T_floor_camera's rotation
-    Eigen::Vector3f up_c;     // up in camera coordinates
-    float sin_tol = 0.f;      // sin(vertical_tolerance)
+    Eigen::Matrix3f R;     // T_floor_camera's rotation
+    Eigen::Vector3f up_c;  // up in camera coordinates
+    float sin_tol = 0.f;   // sin(vertical_tolerance)
     float camera_height = 0.f, full_w = 0.f, clip_depth = 0.f;
   };
   /// Fills votes_ (one per vertical plane, or level band); returns the regions' total area.
@@ -207,7 +210,8 @@ class ManhattanTracker {
   /// Fills vetoes_: the walls seen beyond the planes that make `frame` that disagree with them.
   void find_vetoes(const ManhattanEstimate& frame, bool riser_frame, bool bounding_only);
   /// The frame the vetoing walls (or the image edges agreeing with them) give; false: none.
-  bool apply_vetoes(ManhattanEstimate& frame, float total_area, const std::function<EdgeCompassResult()>& compass,
+  bool apply_vetoes(ManhattanEstimate& frame, float total_area,
+                    const std::function<EdgeCompassResult()>& compass,
                     std::optional<EdgeCompassResult>& compass_cache) const;
 
   ManhattanConfig cfg_;
@@ -216,11 +220,11 @@ class ManhattanTracker {
   std::optional<float> prev_yaw_;
   std::vector<const Vote*> pair_candidates_;  // scratch: agreeing planes wide enough to make a pair
   std::vector<const Vote*> vetoes_;           // scratch: the walls that veto the frame
-  std::vector<Vote> votes_;               // scratch
-  std::vector<FloorSample> floor_pts_;    // scratch
-  std::vector<StructureSample> struct_pts_;  // scratch: samples of the regions other than the floor
-  std::vector<std::size_t> region_samples_;  // scratch: region k's samples start at [k], end at [k + 1]
-  std::vector<char> stacked_;                // scratch: mark_risers' candidates on or under another
+  std::vector<Vote> votes_;                   // scratch
+  std::vector<FloorSample> floor_pts_;        // scratch
+  std::vector<StructureSample> struct_pts_;   // scratch: samples of the regions other than the floor
+  std::vector<std::size_t> region_samples_;   // scratch: region k's samples start at [k], end at [k + 1]
+  std::vector<char> stacked_;                 // scratch: mark_risers' candidates on or under another
 };
 
 }  // namespace stairguide

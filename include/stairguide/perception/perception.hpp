@@ -37,8 +37,8 @@ struct ManhattanSighting {
 
 class Perception {
  public:
-  Perception(const SegmentationConfig& seg = {}, const FloorConfig& floor = {}, const ManhattanConfig& manhattan = {},
-             const ClassificationConfig& classification = {});
+  Perception(const SegmentationConfig& seg = {}, const FloorConfig& floor = {},
+             const ManhattanConfig& manhattan = {}, const ClassificationConfig& classification = {});
   explicit Perception(const PipelineConfig& config);
 
   /// Runs every stage on `frame` into `out` (its vectors are reused). A frame without a floor

@@ -62,9 +62,15 @@ struct PointMoments {
   double w = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
   void add(float x, float y, float z, double weight = 1.0) {
     w += weight;
-    sx += weight * x; sy += weight * y; sz += weight * z;
-    sxx += weight * x * x; sxy += weight * x * y; sxz += weight * x * z;
-    syy += weight * y * y; syz += weight * y * z; szz += weight * z * z;
+    sx += weight * x;
+    sy += weight * y;
+    sz += weight * z;
+    sxx += weight * x * x;
+    sxy += weight * x * y;
+    sxz += weight * x * z;
+    syy += weight * y * y;
+    syz += weight * y * z;
+    szz += weight * z * z;
   }
 };
 
@@ -76,18 +82,40 @@ struct PointMoments {
 struct InvDepthMoments {
   double n = 0, su = 0, sv = 0, sw = 0, suu = 0, suv = 0, svv = 0, suw = 0, svw = 0, sww = 0;
   void add(float u, float v, float w) {
-    n += 1.0; su += u; sv += v; sw += w;
-    suu += double(u) * u; suv += double(u) * v; svv += double(v) * v;
-    suw += double(u) * w; svw += double(v) * w; sww += double(w) * w;
+    n += 1.0;
+    su += u;
+    sv += v;
+    sw += w;
+    suu += double(u) * u;
+    suv += double(u) * v;
+    svv += double(v) * v;
+    suw += double(u) * w;
+    svw += double(v) * w;
+    sww += double(w) * w;
   }
   void sub(float u, float v, float w) {
-    n -= 1.0; su -= u; sv -= v; sw -= w;
-    suu -= double(u) * u; suv -= double(u) * v; svv -= double(v) * v;
-    suw -= double(u) * w; svw -= double(v) * w; sww -= double(w) * w;
+    n -= 1.0;
+    su -= u;
+    sv -= v;
+    sw -= w;
+    suu -= double(u) * u;
+    suv -= double(u) * v;
+    svv -= double(v) * v;
+    suw -= double(u) * w;
+    svw -= double(v) * w;
+    sww -= double(w) * w;
   }
   void add(const InvDepthMoments& o) {
-    n += o.n; su += o.su; sv += o.sv; sw += o.sw; suu += o.suu; suv += o.suv; svv += o.svv;
-    suw += o.suw; svw += o.svw; sww += o.sww;
+    n += o.n;
+    su += o.su;
+    sv += o.sv;
+    sw += o.sw;
+    suu += o.suu;
+    suv += o.suv;
+    svv += o.svv;
+    suw += o.suw;
+    svw += o.svw;
+    sww += o.sww;
   }
   /// Mean residual in 1/z of these points under the plane 1/z = a u' + b v' + c.
   double mean_residual(double a, double b, double c) const {
@@ -100,10 +128,11 @@ struct PlaneFit {
   bool ok = false;
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();
   float d = 0.f;
-  Eigen::Vector3f mean = Eigen::Vector3f::Zero();  ///< centroid (PCA fits; inverse-depth fits: the point at the mean pixel)
+  Eigen::Vector3f mean =
+      Eigen::Vector3f::Zero();      ///< centroid (PCA fits; inverse-depth fits: the point at the mean pixel)
   float a = 0.f, b = 0.f, c = 0.f;  ///< inverse-depth form 1/z = a u' + b v' + c (inverse-depth fits)
   float rms_w = 0.f;                ///< residual RMS in 1/z (1/m) (inverse-depth fits)
-  Eigen::Vector3f eigenvalues = Eigen::Vector3f::Zero();  ///< ascending variances (PCA fits)
+  Eigen::Vector3f eigenvalues = Eigen::Vector3f::Zero();       ///< ascending variances (PCA fits)
   Eigen::Matrix3f eigenvectors = Eigen::Matrix3f::Identity();  ///< columns (PCA fits)
 };
 /// Least-squares plane in inverse depth (see InvDepthMoments).
@@ -124,14 +153,14 @@ struct SegmentationStats {
   /// Milliseconds per step (for `stairguide bench perception`).
   double backproject_ms = 0, grow_ms = 0, merge_ms = 0, refine_ms = 0, finalize_ms = 0, clusters_ms = 0;
   double cells_ms = 0, seeds_ms = 0, strips_ms = 0;  ///< parts of grow_ms: cell pass, fine seeds, strip seeds
-  int regions_dropped = 0;  ///< grown regions below region_min_pixels or failing the planarity check
-  int dominant_directions = 0;  ///< normals the thin-strip seeds may take
+  int regions_dropped = 0;       ///< grown regions below region_min_pixels or failing the planarity check
+  int dominant_directions = 0;   ///< normals the thin-strip seeds may take
   int fixed_normal_regions = 0;  ///< regions grown with a dominant direction's normal
-  int curved_tiles = 0;  ///< small regions dropped as facets of a curved surface
-  int crease_splits = 0;  ///< regions split along a crease between two dominant directions
-  int border_splits = 0;  ///< bands at the top border split off their region
-  int edge_splits = 0;    ///< bands below an occlusion edge split off their region
-  int line_regions = 0;   ///< regions grown from one-row line seeds (line_pass)
+  int curved_tiles = 0;          ///< small regions dropped as facets of a curved surface
+  int crease_splits = 0;         ///< regions split along a crease between two dominant directions
+  int border_splits = 0;         ///< bands at the top border split off their region
+  int edge_splits = 0;           ///< bands below an occlusion edge split off their region
+  int line_regions = 0;          ///< regions grown from one-row line seeds (line_pass)
 };
 
 /// The segmentation stage. Keeps its buffers between calls (same image size: no reallocation).
@@ -193,7 +222,8 @@ class Segmentation {
   /// kReach columns either way) that lie on the plane within the noise and continue their
   /// neighbour's depth, refitting as the region doubles (g.dir >= 0: normal fixed), and refits
   /// g's plane at the end. Returns how many pixels it labelled (queue_[0, n)).
-  template <int kReach> int grow_pixels(int region, const std::vector<int>& seed_pixels, Grow& g);
+  template <int kReach>
+  int grow_pixels(int region, const std::vector<int>& seed_pixels, Grow& g);
   /// Gives a dropped growth's `tail` pixels back (released_), empties g; returns whether it was
   /// grown on a dominant direction (`dir`) its pixels reject.
   bool release_growth(int tail, Grow& g, int dir);
@@ -294,11 +324,11 @@ class Segmentation {
   CameraIntrinsics K_;
   int W_ = 0, H_ = 0;
   std::uint64_t div_magic_ = 0;
-  std::vector<float> z_;           // depth, 0 where no reading (x = u' z, y = v' z)
-  std::vector<float> w_;           // 1/z, 0 where no reading
-  std::vector<float> un_, vn_;     // normalised image coordinates per column / row
-  std::vector<float> gu_, gv_;     // offsets of the normalised coordinates inside a cell
-  std::vector<int> ucell_, vcell_; // cell column / row of each image column / row
+  std::vector<float> z_;            // depth, 0 where no reading (x = u' z, y = v' z)
+  std::vector<float> w_;            // 1/z, 0 where no reading
+  std::vector<float> un_, vn_;      // normalised image coordinates per column / row
+  std::vector<float> gu_, gv_;      // offsets of the normalised coordinates inside a cell
+  std::vector<int> ucell_, vcell_;  // cell column / row of each image column / row
   std::vector<int> label_;
   std::vector<int> queue_;
   std::vector<int> seed_pixels_, next_;
@@ -311,7 +341,7 @@ class Segmentation {
     int u0, v, n;
     float score;
   };
-  std::vector<LineSeed> line_seeds_;  // line_pass: runs of free pixels in one row
+  std::vector<LineSeed> line_seeds_;      // line_pass: runs of free pixels in one row
   std::vector<std::uint64_t> sort_keys_;  // sort_cells: (score bits, index) keys
   /// Sorts cells_ by ascending score, in the very order std::sort on the cells gives (ties too).
   void sort_cells();
@@ -322,10 +352,10 @@ class Segmentation {
   };
   std::vector<RegionAcc> acc_;
   std::vector<PlaneFit> fits_;
-  std::vector<std::vector<int>> pixel_pool_;               // finalize: buffers of regions not in use
+  std::vector<std::vector<int>> pixel_pool_;  // finalize: buffers of regions not in use
   std::vector<std::vector<Eigen::Vector3f>> point_pool_;
   std::vector<std::vector<Eigen::Vector3f>> cluster_pool_;  // extract_clusters: point buffers not in use
-  int CW_ = 0, CH_ = 0;                  // cell grid
+  int CW_ = 0, CH_ = 0;                                     // cell grid
   std::vector<InvDepthMoments> cell_m_;
   std::vector<int> cell_label_;
   std::vector<std::uint8_t> cell_planar_;
@@ -345,8 +375,8 @@ class Segmentation {
   std::vector<std::uint16_t> contact_, smooth_;
   std::vector<float> area_;
   std::vector<float> edge_acc_;  // split_edge_bands: residual sums per candidate region and band row
-  std::vector<Eigen::Vector3f> big_dirs_;  // region pairs: seam samples, depth-continuous ones
-  std::vector<InvDepthMoments> bins_;  // split passes: moments per sweep bin / row
+  std::vector<Eigen::Vector3f> big_dirs_;    // region pairs: seam samples, depth-continuous ones
+  std::vector<InvDepthMoments> bins_;        // split passes: moments per sweep bin / row
   std::vector<InvDepthMoments> slant_bins_;  // split_slanted_border_band: moments per sweep step
   std::vector<int> split_pixels_, split_side_;
   struct SplitCand {

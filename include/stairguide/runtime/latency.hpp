@@ -36,11 +36,11 @@ class LatencyHistogram {
 /// first sample handed to the sound device (a cue said in one phrase with others of its frame
 /// counts from the phrase's first sample; a step cue told by an earcon, from the earcon's).
 struct CueKindLatency {
-  std::string kind;                 ///< feedback::to_string(Cue): "tick", "count", ...
-  std::uint64_t given = 0;          ///< cues of this kind given by the policy
-  std::uint64_t sounded = 0;        ///< of them, started on the sound device
-  std::uint64_t late = 0;           ///< started after the next step's frame (its step had passed)
-  std::vector<double> samples_ms;   ///< every latency measured, in the order started
+  std::string kind;                ///< feedback::to_string(Cue): "tick", "count", ...
+  std::uint64_t given = 0;         ///< cues of this kind given by the policy
+  std::uint64_t sounded = 0;       ///< of them, started on the sound device
+  std::uint64_t late = 0;          ///< started after the next step's frame (its step had passed)
+  std::vector<double> samples_ms;  ///< every latency measured, in the order started
   /// The feedback path's share of each: the decision on the frame -> its first sample handed
   /// (the rest is capture -> decision, the stages' time).
   std::vector<double> from_decision_ms;

@@ -28,7 +28,7 @@ namespace stairguide {
 struct OdometryLink;  // perception/perception.hpp
 struct SceneResult;   // perception/scene.hpp
 struct StairResult;   // stairs/stair_result.hpp
-}
+}  // namespace stairguide
 
 namespace stairguide::runtime {
 
@@ -64,9 +64,10 @@ struct PerceptionOutput {
   int rig_learned = 0;  ///< FloorDetector::rig_learned(): changes when the rig is learned anew
   /// The typed results: what the feedback room reads (as numbers, not from `detail`).
   StairSummary stair;
-  DropSummary drop;           ///< a drop-off ahead (stairs/drop_detection.hpp); not told when `stair` goes down
-  TraversalResult traversal;  ///< the traversal tracker (stairs/traversal.hpp); `ran` false when traversal.enabled is off
-  double ms = 0.0;     ///< time spent in the stages
+  DropSummary drop;  ///< a drop-off ahead (stairs/drop_detection.hpp); not told when `stair` goes down
+  TraversalResult
+      traversal;  ///< the traversal tracker (stairs/traversal.hpp); `ran` false when traversal.enabled is off
+  double ms = 0.0;  ///< time spent in the stages
 };
 
 /// What the odometry says of a frame's pose.
@@ -170,11 +171,11 @@ class FeedbackStage {
     std::uint64_t sounded = 0;  ///< of them, started on the sound device
     std::uint64_t lost = 0;     ///< of them, dropped unplayed (the sound device could not take them)
     double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
-    std::string last;  ///< token of the last cue given ("" none)
+    std::string last;                     ///< token of the last cue given ("" none)
     std::vector<CueKindLatency> by_kind;  ///< per cue kind given at least once, in Cue order
   };
   CueLatency cue_latency() const;  ///< any thread
-  void clear_cue_latency();         ///< forgets the latencies measured so far (benchmarks)
+  void clear_cue_latency();        ///< forgets the latencies measured so far (benchmarks)
 
  private:
   struct Impl;

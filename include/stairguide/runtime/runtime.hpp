@@ -116,12 +116,12 @@ struct RuntimeStats {
   std::uint64_t timestamps_replaced = 0;
   double odometry_ms_mean = 0.0;  ///< mean time in the odometry stage
   double perception_ms_mean = 0.0;
-  std::uint64_t cues = 0;          ///< cues given to the user (feedback)
-  std::uint64_t cues_sounded = 0;  ///< of them, started on the sound device
-  std::uint64_t cues_lost = 0;     ///< of them, never played: the sound device could not take them
-  double cue_latency_p50_ms = 0.0; ///< capture of the frame warranting a cue -> its first sample out
+  std::uint64_t cues = 0;           ///< cues given to the user (feedback)
+  std::uint64_t cues_sounded = 0;   ///< of them, started on the sound device
+  std::uint64_t cues_lost = 0;      ///< of them, never played: the sound device could not take them
+  double cue_latency_p50_ms = 0.0;  ///< capture of the frame warranting a cue -> its first sample out
   double cue_latency_p99_ms = 0.0;
-  std::string last_cue;            ///< token of the last cue ("" none)
+  std::string last_cue;                   ///< token of the last cue ("" none)
   std::vector<CueKindLatency> cue_kinds;  ///< the cue latency per cue kind (FeedbackStage)
   /// The traversal as of the last decision (issue 32): state token, step the user stands on,
   /// steps left (-1 unknown), steps known.

@@ -56,10 +56,10 @@ struct DropResult {
   float bearing_rad = std::numeric_limits<float>::quiet_NaN();
   /// m, median depth below the floor of the surfaces seen beyond the edge.
   float depth_m = std::numeric_limits<float>::quiet_NaN();
-  float width_m = 0.f;    ///< m, length of the edge found
-  int columns = 0;        ///< sampled columns on the edge
-  int deep_columns = 0;   ///< ... of which saw a surface below the floor beyond it
-  double ms = 0.0;        ///< time spent
+  float width_m = 0.f;   ///< m, length of the edge found
+  int columns = 0;       ///< sampled columns on the edge
+  int deep_columns = 0;  ///< ... of which saw a surface below the floor beyond it
+  double ms = 0.0;       ///< time spent
 };
 
 /// Looks for a drop-off in `frame` given perception's `scene` (its floor).

@@ -100,16 +100,16 @@ namespace stairguide {
 
 /// What the floorless route saw in the last frame (for tests and the CLI).
 struct FloorlessTrace {
-  bool up_found = false;               ///< a plausible family of horizontal planes was found
+  bool up_found = false;                         ///< a plausible family of horizontal planes was found
   Eigen::Vector3f up = Eigen::Vector3f::Zero();  ///< camera frame, unit, pointing up
-  float tilt = 0.f, roll = 0.f;        ///< rad, camera pitch below horizontal and roll implied by `up`
-  int family_regions = 0;              ///< regions in the family
-  int levels = 0;                      ///< levels (height x connectivity groups) of the family
-  int stacked = 0;                     ///< levels in the longest stack one riser apart
-  int direction = 0;                   ///< +1 ascending, -1 descending, 0 undecided
-  bool floor_level = false;            ///< the first seen level was taken for the floor (level 0)
-  bool anchored = false;               ///< levels placed from the feet (camera height remembered or floor seen)
-  bool floor_seen = false;             ///< cold start: the user's floor seen outside the stack gave the camera height
+  float tilt = 0.f, roll = 0.f;  ///< rad, camera pitch below horizontal and roll implied by `up`
+  int family_regions = 0;        ///< regions in the family
+  int levels = 0;                ///< levels (height x connectivity groups) of the family
+  int stacked = 0;               ///< levels in the longest stack one riser apart
+  int direction = 0;             ///< +1 ascending, -1 descending, 0 undecided
+  bool floor_level = false;      ///< the first seen level was taken for the floor (level 0)
+  bool anchored = false;         ///< levels placed from the feet (camera height remembered or floor seen)
+  bool floor_seen = false;  ///< cold start: the user's floor seen outside the stack gave the camera height
   /// The stack's top level was the floor around a stairwell (farther than the first tread below it,
   /// a chest camera's height below the camera): taken out of the stack, descending (see the file comment).
   bool floor_beside = false;
@@ -117,17 +117,21 @@ struct FloorlessTrace {
   /// Cold, two levels going down with an upright face between their heights (a riser facing the
   /// user): the direction is contradicted and nothing is reported.
   bool riser_against = false;
-  int first_index = -1;                ///< steps from the feet to the first seen level (anchored), -1 unknown
-  float first_offset = 0.f;            ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
+  int first_index = -1;  ///< steps from the feet to the first seen level (anchored), -1 unknown
+  float first_offset =
+      0.f;  ///< m, first seen level's height beyond the feet (anchored; up ascending, down descending)
   /// m, anchored: how far the chest had moved towards the flight (first_index risers less
   /// first_offset) when that is more than the anchor tolerance (the user stepping onto it); 0 otherwise.
   float lean = 0.f;
-  float lean_edge_ahead = 0.f;         ///< m, with a lean or the extra hidden steps: the first edge's distance ahead of the camera's vertical
-  bool first_near_cut = false;         ///< the first seen level's near boundary lies on the image border
-  float first_depth = 0.f;             ///< m, cold start: depth seen of that level (a floor strip deeper than a tread is the floor)
-  int edges_seen = 0;                  ///< step edges seen inside the image (tread edges or risers)
-  std::vector<float> level_heights;    ///< m, up . p of each stacked level, lowest first
-  std::vector<float> near_distances;   ///< m, each stacked level's near boundary from the camera's vertical, lowest first
+  float lean_edge_ahead = 0.f;  ///< m, with a lean or the extra hidden steps: the first edge's distance ahead
+                                ///< of the camera's vertical
+  bool first_near_cut = false;  ///< the first seen level's near boundary lies on the image border
+  float first_depth =
+      0.f;  ///< m, cold start: depth seen of that level (a floor strip deeper than a tread is the floor)
+  int edges_seen = 0;                ///< step edges seen inside the image (tread edges or risers)
+  std::vector<float> level_heights;  ///< m, up . p of each stacked level, lowest first
+  std::vector<float>
+      near_distances;  ///< m, each stacked level's near boundary from the camera's vertical, lowest first
 };
 
 /// The floorless route. Pure: no I/O, no exceptions; buffers are kept between frames.
@@ -147,8 +151,8 @@ class FloorlessStairs {
 
  private:
   struct Node {
-    std::vector<int> regions;             ///< indices into the input scene
-    float height = 0.f;                   ///< m, up . p, pixel-weighted
+    std::vector<int> regions;  ///< indices into the input scene
+    float height = 0.f;        ///< m, up . p, pixel-weighted
     int pixels = 0;
     std::vector<Eigen::Vector3f> sample;  ///< evenly subsampled points of all its regions
     Eigen::Vector3f lo, hi;               ///< bounding box of the sample
@@ -209,7 +213,8 @@ class FloorlessStairs {
   /// n+1: above the top level), from the input scene; NaN where none.
   void riser_positions(const SceneResult& scene, const StairResult& r, int n, float level0_plane);
   /// Pseudo floor frame at `level0`, steps chain_[first..], modelling, edges refined.
-  void model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0, StairResult& out);
+  void model(const SceneResult& scene, const CameraIntrinsics* K, int dir, int first, float level0,
+             StairResult& out);
   /// True when most of level k's edge line (at height y in the stair frame) lies on the image border.
   bool edge_cut(const CameraIntrinsics& K, const StairResult& r, int k, float y) const;
   /// The same for the line across level k at `z` along z_S.
@@ -236,7 +241,8 @@ class FloorlessStairs {
   /// The step edges seen inside the image (k, position along z_S) into edge_k_, edge_e_: a riser
   /// facing the user (plus the nosing measured where both agree) or a tread edge not on the image
   /// border (trace_.edges_seen).
-  void collect_seen_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n, StairResult& out);
+  void collect_seen_edges(const SceneResult& scene, const CameraIntrinsics* K, int dir, int n,
+                          StairResult& out);
   /// Tread from the seen edges by consensus (out.tread_m) and the origin's `shift` along z_S;
   /// false, with kInconsistentEdges, when fewer than two thirds of the edges agree.
   bool fit_seen_edges(int dir, StairResult& out, float& shift) const;
@@ -250,17 +256,17 @@ class FloorlessStairs {
   StairModelling modelling_;
   FloorlessTrace trace_;
 
-  std::vector<int> cand_;               ///< regions plausible as horizontal
-  std::vector<int> family_;             ///< regions of the family
-  std::vector<float> height_;           ///< per family member
+  std::vector<int> cand_;      ///< regions plausible as horizontal
+  std::vector<int> family_;    ///< regions of the family
+  std::vector<float> height_;  ///< per family member
   std::vector<Node> nodes_;
   std::vector<int> order_, best_len_, best_prev_, chain_;
   std::vector<long> best_pix_;
   std::vector<float> dist_, tmp_, riser_pos_, edge_k_, edge_e_;
   std::vector<int> riser_n_;
-  std::vector<int> index_map_;          ///< pseudo-scene region -> input region
-  float level0_ = 0.f;                  ///< up . p of the virtual level 0 (camera frame), m
-  SceneResult pseudo_;                  ///< the pseudo floor frame and the regions modelling needs
+  std::vector<int> index_map_;  ///< pseudo-scene region -> input region
+  float level0_ = 0.f;          ///< up . p of the virtual level 0 (camera frame), m
+  SceneResult pseudo_;          ///< the pseudo floor frame and the regions modelling needs
   StairHypothesis hyp_;
 };
 

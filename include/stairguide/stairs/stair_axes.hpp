@@ -32,7 +32,8 @@ struct StairFrame {
 /// The common normal of the horizontal levels of `hyp` (camera frame, on the side of `up0`), or
 /// `up0` (the floor's up) when the levels give too few points (50) or a normal more than 3 degrees
 /// from it. Pure.
-Eigen::Vector3f fit_stair_vertical(const SceneResult& scene, const StairHypothesis& hyp, const Eigen::Vector3f& up0);
+Eigen::Vector3f fit_stair_vertical(const SceneResult& scene, const StairHypothesis& hyp,
+                                   const Eigen::Vector3f& up0);
 
 /// A frame with vertical `up` and its horizontal basis: e1 is the camera's forward (z) made
 /// horizontal (its x when looking straight down), e2 = up x e1. x2, z2, xs, zs are left zero.

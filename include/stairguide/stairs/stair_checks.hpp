@@ -21,22 +21,22 @@ namespace stairguide {
 /// the physical range: risers 5-25 cm, goings 15-60 cm, width from 0.5 m (an adult's shoulders;
 /// 0.4 m let a shoe bench's 40 cm boards through as a flight on held-out seed 801).
 struct WalkableLimits {
-  float riser_min = 0.05f;   ///< m, lower than this is no step (a threshold, a rug)
-  float riser_max = 0.25f;   ///< m, higher than this is no step one climbs (a ledge, a seat)
-  float tread_min = 0.15f;   ///< m, a level shallower than this cannot hold a foot
-  float tread_max = 0.60f;   ///< m, levels farther apart than a stride are no flight's consecutive steps
-  float width_min = 0.50f;   ///< m, narrower than shoulders (a ladder, a shoe bench's 40 cm boards)
+  float riser_min = 0.05f;      ///< m, lower than this is no step (a threshold, a rug)
+  float riser_max = 0.25f;      ///< m, higher than this is no step one climbs (a ledge, a seat)
+  float tread_min = 0.15f;      ///< m, a level shallower than this cannot hold a foot
+  float tread_max = 0.60f;      ///< m, levels farther apart than a stride are no flight's consecutive steps
+  float width_min = 0.50f;      ///< m, narrower than shoulders (a ladder, a shoe bench's 40 cm boards)
   float width_cut_min = 0.30f;  ///< m, a width cut by the view (a lower bound) must still reach this
 };
 
 /// Measured dimensions of a modelled staircase, as the checks need them.
 struct StairDimensions {
-  float riser = 0.f;           ///< m
-  float tread = 0.f;           ///< m; meaningful only when `tread_known`
-  bool tread_known = false;    ///< two or more step edges seen
-  float width = 0.f;           ///< m, widest step seen
-  bool width_complete = false; ///< both lateral ends in view (else `width` is a lower bound)
-  float range = 0.f;           ///< m, camera to the first edge (the slack grows with it)
+  float riser = 0.f;            ///< m
+  float tread = 0.f;            ///< m; meaningful only when `tread_known`
+  bool tread_known = false;     ///< two or more step edges seen
+  float width = 0.f;            ///< m, widest step seen
+  bool width_complete = false;  ///< both lateral ends in view (else `width` is a lower bound)
+  float range = 0.f;            ///< m, camera to the first edge (the slack grows with it)
 };
 
 /// Physical walkability: kDetected, or the physical reason it cannot be walked

@@ -48,12 +48,12 @@ struct LevelSeed {
 
 /// The levels of one direction (ascending or descending).
 struct StairHypothesis {
-  int direction = 0;                 ///< +1 ascending, -1 descending
+  int direction = 0;                                   ///< +1 ascending, -1 descending
   StairVerdict verdict = StairVerdict::kNoCandidates;  ///< kDetected when at least one level was found
-  int candidates = 0;                ///< step candidates on this side of the floor
-  int rejected = 0;                  ///< of those, left out (not connected, wrong height)
-  int hidden_steps = 0;              ///< steps between the floor and the first level seen, out of view
-  std::vector<LevelSeed> levels;     ///< [0] is the floor (its regions may be empty), then steps 1..n
+  int candidates = 0;                                  ///< step candidates on this side of the floor
+  int rejected = 0;                                    ///< of those, left out (not connected, wrong height)
+  int hidden_steps = 0;           ///< steps between the floor and the first level seen, out of view
+  std::vector<LevelSeed> levels;  ///< [0] is the floor (its regions may be empty), then steps 1..n
   int step_levels() const { return levels.empty() ? 0 : static_cast<int>(levels.size()) - 1; }
 };
 
@@ -75,17 +75,18 @@ class StairDetection {
  private:
   struct Candidate {
     int region = -1;
-    float height = 0.f;                    ///< m above the floor (signed)
-    Eigen::Vector3f lo, hi;                ///< bounding box of the sample, camera frame
-    std::vector<Eigen::Vector3f> sample;   ///< evenly subsampled points
-    int stride = 1;                        ///< points per sample point
+    float height = 0.f;                   ///< m above the floor (signed)
+    Eigen::Vector3f lo, hi;               ///< bounding box of the sample, camera frame
+    std::vector<Eigen::Vector3f> sample;  ///< evenly subsampled points
+    int stride = 1;                       ///< points per sample point
   };
 
   void prepare(const SceneResult& scene, int region, Candidate& c) const;
   /// Points of `c` within the radius of the regions of `level`, >= the minimum (scaled by stride).
   /// With `horizontal`, distances are taken in the horizontal plane (heights left out). A positive
   /// `radius` replaces the configured connection radius.
-  bool connected(const Candidate& c, const LevelSeed& level, bool horizontal = false, float radius = 0.f) const;
+  bool connected(const Candidate& c, const LevelSeed& level, bool horizontal = false,
+                 float radius = 0.f) const;
   void build(int direction, StairHypothesis& hyp);
   /// Algorithm 1's loop: adds unassigned candidates to the levels of `hyp` until nothing changes.
   void sweep(StairHypothesis& hyp);
@@ -104,10 +105,10 @@ class StairDetection {
 
   ClassificationConfig cls_;
   StairDetectionConfig cfg_;
-  std::vector<Candidate> pool_;        ///< prepared regions (candidates and floor), reused
-  std::vector<int> region_slot_;       ///< region index -> slot in pool_, -1 when none
-  std::vector<int> candidates_;        ///< slots of step candidates
-  std::vector<int> floor_slots_;       ///< slots of floor regions
+  std::vector<Candidate> pool_;   ///< prepared regions (candidates and floor), reused
+  std::vector<int> region_slot_;  ///< region index -> slot in pool_, -1 when none
+  std::vector<int> candidates_;   ///< slots of step candidates
+  std::vector<int> floor_slots_;  ///< slots of floor regions
   std::vector<int> order_;
   std::vector<char> assigned_;
   // Scratch for setting a lone first level aside (build): the sweep's state before, reused.

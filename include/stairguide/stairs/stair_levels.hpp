@@ -26,9 +26,9 @@ struct StairLevel2d {
   std::vector<Eigen::Vector2f> pts;  ///< ray-projected points in the horizontal basis (e1, e2)
   float plane = 0.f;                 ///< mean of up . p (camera frame), m
   Eigen::Vector2f centroid = Eigen::Vector2f::Zero();
-  std::vector<Eigen::Vector2f> hull; ///< convex hull of a subsample
-  float extent = 0.f;                ///< hull area / PCA rectangle area
-  float pca_angle = 0.f;             ///< rad, major axis in (e1, e2)
+  std::vector<Eigen::Vector2f> hull;  ///< convex hull of a subsample
+  float extent = 0.f;                 ///< hull area / PCA rectangle area
+  float pca_angle = 0.f;              ///< rad, major axis in (e1, e2)
 };
 
 /// Projects the regions of `seed` (an even subsample of at most about `max_points` points) along

@@ -109,7 +109,8 @@ class StairModelling {
   /// Clears `out` for hypothesis `hyp` with n step levels (verdict kNoFirstStep).
   void reset_result(const StairHypothesis& hyp, int n, StairResult& out) const;
   /// Levels (stair_levels.cpp): every level projected into levels_, step outlines, the seed step.
-  LevelsSeen project_levels(const SceneResult& scene, const StairHypothesis& hyp, int n, const StairFrame& frame);
+  LevelsSeen project_levels(const SceneResult& scene, const StairHypothesis& hyp, int n,
+                            const StairFrame& frame);
   /// Axes (stair_axes.cpp): the horizontal axes (x_S, z_S) into `frame`; returns the method.
   StairAxesMethod fit_axes(const SceneResult& scene, int n, int seed, StairFrame& frame);
   /// Minimum summed bounding-rectangle area of steps 1..n, searched from `seed_angle`.
@@ -121,7 +122,8 @@ class StairModelling {
   /// The lateral span of the steps and whether each end is seen.
   StairSpan lateral_span(const StairFrame& frame, int n, int steps_not_landing, const StairResult& out) const;
   /// Going up: a step seen whole across yet far narrower than the staircase (an object on a surface).
-  bool narrow_level_on_surface(const StairFrame& frame, int n, int dir, float width, const StairResult& out) const;
+  bool narrow_level_on_surface(const StairFrame& frame, int n, int dir, float width,
+                               const StairResult& out) const;
   /// The floor before the first step: its extent (ascending) or its far edge (descending).
   FloorSeen floor_before_steps(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame,
                                int n, int dir, const StairSpan& span, StairResult& out);
@@ -148,21 +150,21 @@ class StairModelling {
                               StairResult& out) const;
   /// Decision (stair_decision.cpp): is the "floor" the one the user stands on? Sets the verdict
   /// kFloorDoubtful and returns true when it is not sure.
-  bool floor_doubtful(const SceneResult& scene, const StairHypothesis& hyp, int n, int dir, const StairFrame& frame,
-                      const StairSpan& span, const FloorSeen& floor, float riser, float edge_b,
-                      StairResult& out) const;
+  bool floor_doubtful(const SceneResult& scene, const StairHypothesis& hyp, int n, int dir,
+                      const StairFrame& frame, const StairSpan& span, const FloorSeen& floor, float riser,
+                      float edge_b, StairResult& out) const;
   /// A single level: obstacle, single step or curb.
-  void decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir, const StairFrame& frame,
-                           const StairSpan& span, const FloorSeen& floor, float riser, const StairOrigin& o,
-                           StairResult& out) const;
+  void decide_single_level(const SceneResult& scene, const StairHypothesis& hyp, int dir,
+                           const StairFrame& frame, const StairSpan& span, const FloorSeen& floor,
+                           float riser, const StairOrigin& o, StairResult& out) const;
   /// Single level: does it run out of the image at its far side (its depth then only a lower bound)?
   bool far_side_out_of_view(const StairFrame& frame, float a_mid, float edge_b, const StairLevel& o) const;
   /// Single level below the floor: does its seen strip start at the shadow of the floor's edge (a
   /// drop, however shallow)?
   bool strip_at_floor_edge_shadow(float riser, const StairLevel& o, const StairResult& out) const;
   /// Single level: a horizontal surface above it, within its footprint (furniture, no step).
-  bool surface_above(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame, float a_mid,
-                     float edge_b, const StairLevel& o) const;
+  bool surface_above(const SceneResult& scene, const StairHypothesis& hyp, const StairFrame& frame,
+                     float a_mid, float edge_b, const StairLevel& o) const;
   /// A flight: physical checks (stair_checks.hpp) and the edges' consistency.
   void decide_flight(int dir, const StairSpan& span, const StairProfile& profile, const StairOrigin& o,
                      StairResult& out) const;
@@ -176,9 +178,10 @@ class StairModelling {
   float area_cost(float angle, int first, int last) const;
   /// Nearest (low) or farthest point of each lateral bin into bin_a_/bin_e_ (those on the image
   /// border dropped when the intrinsics are known); returns their median.
-  float boundary_median_ab(const std::vector<float>& a, const std::vector<float>& b, bool low, const BoundaryFrame& f);
-  float boundary_median(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
-                        const BoundaryFrame& f);
+  float boundary_median_ab(const std::vector<float>& a, const std::vector<float>& b, bool low,
+                           const BoundaryFrame& f);
+  float boundary_median(const std::vector<Eigen::Vector2f>& pts, const Eigen::Vector2f& x2,
+                        const Eigen::Vector2f& z2, const BoundaryFrame& f);
   /// The near boundary from the bins of the last boundary_median: the median of the largest group
   /// of bins at one depth (the edge), or `median` when fewer than 5 agree.
   float boundary_mode(float median);
@@ -193,7 +196,8 @@ class StairModelling {
   /// Going up (levels 1..n in the basis x2, z2, their extents in out.level_data): true when a level
   /// shows well beyond the far side of the next one up, within its width: it carries that level
   /// (a box on a shelf board), no flight does.
-  bool level_stands_on_lower(int n, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2, const StairResult& out) const;
+  bool level_stands_on_lower(int n, const Eigen::Vector2f& x2, const Eigen::Vector2f& z2,
+                             const StairResult& out) const;
   /// Turns z2 so that the near boundary of a single level runs along x.
   void refine_single_axis(const StairLevel2d& level, Eigen::Vector2f& z2, const Eigen::Vector3f& e1,
                           const Eigen::Vector3f& e2, const Eigen::Vector3f& up);
@@ -207,13 +211,14 @@ class StairModelling {
   std::vector<float> fit_k_, fit_e_;  ///< scratch for the edge fit
   std::vector<int> fit_level_;        ///< level (position in the hypothesis) of each fit entry
   std::vector<char> fit_in_;          ///< scratch: each fit entry on the tread line
-  std::vector<float> ba_, bb_, a_band_, bin_a_, bin_e_, bin_ext_, bin_at_, sorted_, tmp_;  ///< scratch for boundaries
+  std::vector<float> ba_, bb_, a_band_, bin_a_, bin_e_, bin_ext_, bin_at_, sorted_,
+      tmp_;  ///< scratch for boundaries
   std::vector<int> bin_count_;
-  std::vector<char> landing_;         ///< per level: deeper than a tread (landing or floor)
-  std::vector<char> axis_skip_;       ///< per level: left out of the axes' area cost (a landing)
-  std::vector<char> outlier_;         ///< per level: edge off the staircase's line
-  std::vector<float> riser_at_;       ///< per level: position along z_S of the riser below it (NaN: none)
-  std::vector<int> riser_n_;          ///< per level: points of that riser's region
+  std::vector<char> landing_;            ///< per level: deeper than a tread (landing or floor)
+  std::vector<char> axis_skip_;          ///< per level: left out of the axes' area cost (a landing)
+  std::vector<char> outlier_;            ///< per level: edge off the staircase's line
+  std::vector<float> riser_at_;          ///< per level: position along z_S of the riser below it (NaN: none)
+  std::vector<int> riser_n_;             ///< per level: points of that riser's region
   const CameraIntrinsics* K_ = nullptr;  ///< intrinsics of the frame being modelled, when given
 };
 

@@ -27,9 +27,9 @@ LineFit fit_line(const std::vector<float>& x, const std::vector<float>& y);
 
 /// The step edges' line (edge position against the step index) by consensus.
 struct EdgeLineFit {
-  LineFit line;               ///< refitted to the edges near the consensus line
-  bool consistent = false;    ///< line.ok and two thirds of the edges at least lie on it
-  float max_residual = 0.f;   ///< m, largest distance of an edge on the line from the refitted line
+  LineFit line;              ///< refitted to the edges near the consensus line
+  bool consistent = false;   ///< line.ok and two thirds of the edges at least lie on it
+  float max_residual = 0.f;  ///< m, largest distance of an edge on the line from the refitted line
 };
 
 /// Over the lines through two edges (k[i], e[i]), the one with most edges within `max_residual`

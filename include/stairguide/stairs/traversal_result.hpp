@@ -45,20 +45,25 @@ struct DropSummary {
 
 /// Where the user is with respect to a staircase (paper 5.2).
 enum class TraversalState {
-  kSearching,  ///< no staircase ahead: detection and modelling run as usual
-  kStairAhead, ///< a staircase ahead, not yet on it
-  kOnStairs,   ///< on the flight (step_index >= 1)
-  kLastStep,   ///< the next step (or the one under the feet) is the last
-  kArrived     ///< off the flight onto the new floor (held briefly, then searching)
+  kSearching,   ///< no staircase ahead: detection and modelling run as usual
+  kStairAhead,  ///< a staircase ahead, not yet on it
+  kOnStairs,    ///< on the flight (step_index >= 1)
+  kLastStep,    ///< the next step (or the one under the feet) is the last
+  kArrived      ///< off the flight onto the new floor (held briefly, then searching)
 };
 /// "searching", "stair_ahead", "on_stairs", "last_step", "arrived".
 inline const char* to_string(TraversalState s) {
   switch (s) {
-    case TraversalState::kSearching: return "searching";
-    case TraversalState::kStairAhead: return "stair_ahead";
-    case TraversalState::kOnStairs: return "on_stairs";
-    case TraversalState::kLastStep: return "last_step";
-    case TraversalState::kArrived: return "arrived";
+    case TraversalState::kSearching:
+      return "searching";
+    case TraversalState::kStairAhead:
+      return "stair_ahead";
+    case TraversalState::kOnStairs:
+      return "on_stairs";
+    case TraversalState::kLastStep:
+      return "last_step";
+    case TraversalState::kArrived:
+      return "arrived";
   }
   return "searching";
 }
@@ -74,10 +79,10 @@ struct TraversalResult {
   /// m and rad, to the first edge along the floor and its bearing (as StairSummary); NaN unknown.
   float distance_m = std::numeric_limits<float>::quiet_NaN();
   float bearing_rad = std::numeric_limits<float>::quiet_NaN();
-  int step_index = 0;     ///< step the user stands on: 0 = the floor before the flight, 1 = first step
-  int steps_climbed = 0;  ///< steps gone up or down so far on this flight
-  int steps_known = 0;    ///< steps in the model (grows as new steps come into view)
-  int steps_left = -1;    ///< steps still to go; -1 while the end is not known
+  int step_index = 0;       ///< step the user stands on: 0 = the floor before the flight, 1 = first step
+  int steps_climbed = 0;    ///< steps gone up or down so far on this flight
+  int steps_known = 0;      ///< steps in the model (grows as new steps come into view)
+  int steps_left = -1;      ///< steps still to go; -1 while the end is not known
   bool last_known = false;  ///< the last step has been seen (a long tread or the floor beyond)
   /// Fused model (over the frames of this staircase, quality-weighted).
   float riser_m = 0.f, tread_m = 0.f, width_m = 0.f;

@@ -93,9 +93,9 @@ struct SynthOptions {
   /// as every figure of the test suite was measured. with_real_kinect_noise() sets what the real
   /// clouds show.
   float noise_short_share = 0.f;
-  float noise_short_px = 2.f;   ///< px
+  float noise_short_px = 2.f;  ///< px
   float noise_long_share = 0.f;
-  float noise_long_px = 10.f;   ///< px
+  float noise_long_px = 10.f;  ///< px
   // ---- artefacts seen on the real frames; all off by default (the suites were measured without).
   // Not part of the ground truth's visibility (like the random dropout). with_real_artefacts(). ----
   float speckle_holes = 0.f;  ///< share of the image lost in small blobs (radius 1-3 px) at random
@@ -122,8 +122,8 @@ struct SynthOptions {
   /// px, focal length (fx = fy) at the output size; NaN: 525 px at 640x480 scaled with the size
   /// (synthetic_intrinsics). A Kinect v2's own depth camera: about 365 px at 512x424.
   float focal_px = std::numeric_limits<float>::quiet_NaN();
-  float color_noise = 2.0f;          ///< grey levels, sigma of the colour noise
-  double fps = 30.0;                 ///< Hz, frame rate of the timestamps
+  float color_noise = 2.0f;  ///< grey levels, sigma of the colour noise
+  double fps = 30.0;         ///< Hz, frame rate of the timestamps
 };
 
 /// `o` with depth noise correlated in space as the real Kinect clouds' (shared data
@@ -201,7 +201,8 @@ class PresetRenderer {
   /// `frames` <= 0 takes the preset's default_frames; a sequence asked for more frames than its
   /// default holds its final pose. Throws SourceError for an unknown preset name (the message lists
   /// the known ones) or bad options.
-  PresetRenderer(const std::string& preset, long frames, std::uint32_t seed, const SynthOptions& options = {});
+  PresetRenderer(const std::string& preset, long frames, std::uint32_t seed,
+                 const SynthOptions& options = {});
 
   /// Renders frame `index` (0 .. frames() - 1) into `frame` (depth, colour, grey, timestamp
   /// index / fps, intrinsics) and its ground truth into `truth`.

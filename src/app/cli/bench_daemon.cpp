@@ -154,7 +154,8 @@ runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int fr
       stage.drain(std::chrono::milliseconds(3000));
       stage.clear_cue_latency();
     }
-    std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i + std::chrono::seconds(i >= warmup ? 1 : 0));
+    std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i +
+                                  std::chrono::seconds(i >= warmup ? 1 : 0));
     runtime::PerceptionOutput p;
     p.seq = static_cast<std::uint64_t>(i);
     p.ran = true;
@@ -196,7 +197,9 @@ int bench_cues(const PipelineConfig& config, const std::vector<std::string>& wal
     auto frames = read_frames(*src, -1);
     src.reset();
     const long n = static_cast<long>(frames->size());
-    if (!json) std::fprintf(stderr, "bench daemon --cues: %s: %ld frames at 30 Hz (%.0f s)...\n", walk.c_str(), n, n / 30.0);
+    if (!json)
+      std::fprintf(stderr, "bench daemon --cues: %s: %ld frames at 30 Hz (%.0f s)...\n", walk.c_str(), n,
+                   n / 30.0);
     const Run r = run_once(config, frames, k, desc, n, true, false);
     frames.reset();
     std::uint64_t walk_cues = 0, walk_late = 0;
@@ -213,18 +216,22 @@ int bench_cues(const PipelineConfig& config, const std::vector<std::string>& wal
       for (double v : c.samples_ms) walk_max = std::max(walk_max, v);
     }
     char line[512];
-    std::snprintf(line, sizeof line,
-                  "%s{\"walk\": \"%s\", \"frames\": %ld, \"cues\": %llu, \"late\": %llu, \"cue_latency_max_ms\": %.1f, "
-                  "\"decision_latency_p99_ms\": %.1f, \"perception_drop_rate\": %.4f}",
-                  per_walk.empty() ? "" : ", ", walk.c_str(), n, static_cast<unsigned long long>(walk_cues),
-                  static_cast<unsigned long long>(walk_late), walk_max, r.stats.latency_p99_ms,
-                  r.stats.perception_drop_rate);
+    std::snprintf(
+        line, sizeof line,
+        "%s{\"walk\": \"%s\", \"frames\": %ld, \"cues\": %llu, \"late\": %llu, \"cue_latency_max_ms\": %.1f, "
+        "\"decision_latency_p99_ms\": %.1f, \"perception_drop_rate\": %.4f}",
+        per_walk.empty() ? "" : ", ", walk.c_str(), n, static_cast<unsigned long long>(walk_cues),
+        static_cast<unsigned long long>(walk_late), walk_max, r.stats.latency_p99_ms,
+        r.stats.perception_drop_rate);
     per_walk += line;
     if (!json)
-      std::printf("%-22s %5ld frames  cues %3llu  late %llu  cue latency max %7.1f ms  capture->decision p99 %6.1f ms  "
-                  "perception skipped %.1f%%\n",
-                  walk.c_str(), n, static_cast<unsigned long long>(walk_cues), static_cast<unsigned long long>(walk_late),
-                  walk_max, r.stats.latency_p99_ms, 100.0 * r.stats.perception_drop_rate);
+      std::printf(
+          "%-22s %5ld frames  cues %3llu  late %llu  cue latency max %7.1f ms  capture->decision p99 %6.1f "
+          "ms  "
+          "perception skipped %.1f%%\n",
+          walk.c_str(), n, static_cast<unsigned long long>(walk_cues),
+          static_cast<unsigned long long>(walk_late), walk_max, r.stats.latency_p99_ms,
+          100.0 * r.stats.perception_drop_rate);
   }
   auto pct = [](std::vector<double> v, double p) {
     if (v.empty()) return 0.0;
@@ -244,33 +251,42 @@ int bench_cues(const PipelineConfig& config, const std::vector<std::string>& wal
     if (!a.ms.empty() && p99 > 100.0) pass = false;
     char b[512];
     const double d50 = pct(a.dms, 50), d99 = pct(a.dms, 99);
-    std::snprintf(b, sizeof b, "%s\"%s\": {\"given\": %llu, \"sounded\": %llu, \"late\": %llu, \"p50_ms\": %.1f, \"p99_ms\": %.1f, \"max_ms\": %.1f, "
+    std::snprintf(b, sizeof b,
+                  "%s\"%s\": {\"given\": %llu, \"sounded\": %llu, \"late\": %llu, \"p50_ms\": %.1f, "
+                  "\"p99_ms\": %.1f, \"max_ms\": %.1f, "
                   "\"from_decision_p50_ms\": %.1f, \"from_decision_p99_ms\": %.1f}",
                   kinds_json.empty() ? "" : ", ", name.c_str(), static_cast<unsigned long long>(a.given),
-                  static_cast<unsigned long long>(a.sounded), static_cast<unsigned long long>(a.late), p50, p99, mx, d50, d99);
+                  static_cast<unsigned long long>(a.sounded), static_cast<unsigned long long>(a.late), p50,
+                  p99, mx, d50, d99);
     kinds_json += b;
     if (!json)
-      std::printf("  %-14s given %4llu  sounded %4llu  late %3llu  p50 %7.1f ms  p99 %7.1f ms  max %7.1f ms   "
-                  "(decision -> sound p50 %6.1f p99 %6.1f ms)\n", name.c_str(),
-                  static_cast<unsigned long long>(a.given), static_cast<unsigned long long>(a.sounded),
-                  static_cast<unsigned long long>(a.late), p50, p99, mx, d50, d99);
+      std::printf(
+          "  %-14s given %4llu  sounded %4llu  late %3llu  p50 %7.1f ms  p99 %7.1f ms  max %7.1f ms   "
+          "(decision -> sound p50 %6.1f p99 %6.1f ms)\n",
+          name.c_str(), static_cast<unsigned long long>(a.given), static_cast<unsigned long long>(a.sounded),
+          static_cast<unsigned long long>(a.late), p50, p99, mx, d50, d99);
   }
   if (late > 0) pass = false;
   if (json)
-    std::printf("{\"cue_latency_p50_ms\": %.1f, \"cue_latency_p99_ms\": %.1f, \"late\": %llu, \"kinds\": {%s},\n \"walks\": [%s]}\n",
-                pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), kinds_json.c_str(), per_walk.c_str());
+    std::printf(
+        "{\"cue_latency_p50_ms\": %.1f, \"cue_latency_p99_ms\": %.1f, \"late\": %llu, \"kinds\": {%s},\n "
+        "\"walks\": [%s]}\n",
+        pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), kinds_json.c_str(),
+        per_walk.c_str());
   else
-    std::printf("all cues: p50 %.1f ms p99 %.1f ms, %llu late; target p99 <= 100 ms for every kind and none late: %s\n",
-                pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), pass ? "PASS" : "FAIL");
+    std::printf(
+        "all cues: p50 %.1f ms p99 %.1f ms, %llu late; target p99 <= 100 ms for every kind and none late: "
+        "%s\n",
+        pct(all, 50), pct(all, 99), static_cast<unsigned long long>(late), pass ? "PASS" : "FAIL");
   return 0;
 }
 
 int bench_daemon(Context& ctx) {
   const bool json = ctx.flag("--json");
   const bool cues_only = ctx.flag("--cues");
-  const std::string walks_arg =
-      ctx.option("--walks").value_or("climb_3_steps,climb_8_steps,climb_14_steps,climb_8_pause_turn,climb_8_person,"
-                                     "descend_3_steps,descend_8_steps,descend_14_steps,descend_8_pause_turn,descend_8_person");
+  const std::string walks_arg = ctx.option("--walks").value_or(
+      "climb_3_steps,climb_8_steps,climb_14_steps,climb_8_pause_turn,climb_8_person,"
+      "descend_3_steps,descend_8_steps,descend_14_steps,descend_8_pause_turn,descend_8_person");
   const bool skip_realtime = ctx.flag("--no-realtime");
   const long frames_wanted = ctx.int_option("--frames", 1, 100000).value_or(600);
   const long reference_frames = ctx.int_option("--reference-frames", 0, 100000).value_or(150);
@@ -280,7 +296,7 @@ int bench_daemon(Context& ctx) {
       pos.empty() ? "synth:ascending_approach_climb:" + std::to_string(frames_wanted) + ":1" : pos[0];
 
   runtime::setup_logging("warn");  // the runtime's counters would otherwise go to stdout
-  cv::setNumThreads(1);             // as stairguided does at start (see stairguided_main.cpp)
+  cv::setNumThreads(1);            // as stairguided does at start (see stairguided_main.cpp)
   PipelineConfig config = ctx.config;
   config.runtime.log_level = "warn";
   // Cues to a sound device that takes samples at the pace of a card (the sink holds itself to
@@ -339,23 +355,28 @@ int bench_daemon(Context& ctx) {
         " \"reference\": %s,\n \"cue_path\": {\"cues\": %llu, \"sounded\": %llu, \"p50_ms\": %.2f, "
         "\"p99_ms\": %.2f, \"max_ms\": %.2f}}\n",
         desc.c_str(), n, k.width, k.height, fast.stats.fps, lat.stats.latency_p50_ms,
-        lat.stats.latency_p99_ms, total_lost, lat.stats.perception_drop_rate, ratio, lat.stats.cue_latency_p50_ms,
-        lat.stats.cue_latency_p99_ms, run_json(fast).c_str(), skip_realtime ? "null" : run_json(rt).c_str(),
-        reference_frames > 0 ? run_json(reference).c_str() : "null", static_cast<unsigned long long>(cues.cues),
-        static_cast<unsigned long long>(cues.sounded), cues.p50_ms, cues.p99_ms, cues.max_ms);
+        lat.stats.latency_p99_ms, total_lost, lat.stats.perception_drop_rate, ratio,
+        lat.stats.cue_latency_p50_ms, lat.stats.cue_latency_p99_ms, run_json(fast).c_str(),
+        skip_realtime ? "null" : run_json(rt).c_str(),
+        reference_frames > 0 ? run_json(reference).c_str() : "null",
+        static_cast<unsigned long long>(cues.cues), static_cast<unsigned long long>(cues.sounded),
+        cues.p50_ms, cues.p99_ms, cues.max_ms);
   } else {
     std::printf("stairguide bench daemon: %s, %ld frames %dx%d\n", desc.c_str(), n, k.width, k.height);
     if (reference_frames > 0) print_run("reference (1 thread)", reference);
     print_run("fast replay", fast);
     if (!skip_realtime) print_run("real-time 30 Hz", rt);
     std::printf("threaded fast replay vs one thread: %.2fx frames per second\n", ratio);
-    std::printf("cue path at 30 Hz: %llu cues, %llu sounded, decision -> first sample p50 %.2f ms p99 %.2f ms max %.2f ms\n",
-                static_cast<unsigned long long>(cues.cues), static_cast<unsigned long long>(cues.sounded),
-                cues.p50_ms, cues.p99_ms, cues.max_ms);
+    std::printf(
+        "cue path at 30 Hz: %llu cues, %llu sounded, decision -> first sample p50 %.2f ms p99 %.2f ms max "
+        "%.2f ms\n",
+        static_cast<unsigned long long>(cues.cues), static_cast<unsigned long long>(cues.sounded),
+        cues.p50_ms, cues.p99_ms, cues.max_ms);
     std::printf(
         "targets: fast >= 60 fps: %s (%.1f); every frame through odometry: %s (%llu lost); "
         "real-time p99 <= 50 ms: %s (%.1f); perception drops <= 1%%: %s (%.2f%%); "
-        "cue capture->sound p99 <= 100 ms: %s (%.1f over %llu cues; the cue path's decision->sound p99 %.1f)\n",
+        "cue capture->sound p99 <= 100 ms: %s (%.1f over %llu cues; the cue path's decision->sound p99 "
+        "%.1f)\n",
         fast.stats.fps >= 60 ? "PASS" : "FAIL", fast.stats.fps, total_lost == 0 ? "PASS" : "FAIL", total_lost,
         lat.stats.latency_p99_ms <= 50 ? "PASS" : "FAIL", lat.stats.latency_p99_ms,
         lat.stats.perception_drop_rate <= 0.01 ? "PASS" : "FAIL", 100.0 * lat.stats.perception_drop_rate,

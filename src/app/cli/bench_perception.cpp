@@ -147,7 +147,9 @@ struct Fnv {
     for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
   }
   template <class T>
-  void pod(const T& v) { bytes(&v, sizeof(T)); }
+  void pod(const T& v) {
+    bytes(&v, sizeof(T));
+  }
   template <class T>
   void vec(const std::vector<T>& v) {
     pod(v.size());
@@ -198,7 +200,8 @@ std::vector<std::string> frame_inputs(const std::string& arg) {
     fs::path p(line.substr(b, e - b + 1));
     if (p.is_relative()) p = fs::path(arg).parent_path() / p;
     if (!fs::exists(p, ec))
-      throw UsageError("--frames " + arg + " line " + std::to_string(n) + ": '" + p.string() + "' does not exist");
+      throw UsageError("--frames " + arg + " line " + std::to_string(n) + ": '" + p.string() +
+                       "' does not exist");
     out.push_back(p.string());
   }
   if (out.empty()) throw UsageError("--frames " + arg + ": the list names no input");
@@ -235,7 +238,8 @@ int bench_perception(Context& ctx) {
     }
   } else {
     const long per = count > 0 ? count : 8;
-    for (const char* preset : {"ascending_static", "descending_static", "corridor_static", "room_clutter_static"}) {
+    for (const char* preset :
+         {"ascending_static", "descending_static", "corridor_static", "room_clutter_static"}) {
       auto src = synth::make_source(preset, per, 3);
       RgbdFrame f;
       while (src->read(f).ok()) frames.push_back(f.clone());
@@ -340,35 +344,45 @@ int bench_perception(Context& ctx) {
   const double ratio = med > 0 ? rmed / med : 0.0, cratio = cmed > 0 ? rcmed / cmed : 0.0;
   const int W = frames[0].depth.cols, H = frames[0].depth.rows;
   if (json) {
-    std::printf("{\"frames\": %zu, \"width\": %d, \"height\": %d, \"ours_median_ms\": %.3f, \"ours_p95_ms\": %.3f, "
-                "\"ours_cpu_median_ms\": %.3f, \"ours_cpu_p95_ms\": %.3f, \"reference_median_ms\": %.3f, "
-                "\"reference_p95_ms\": %.3f, \"reference_cpu_median_ms\": %.3f, \"ratio\": %.2f, \"cpu_ratio\": %.2f, "
-                "\"ours_segmentation_median_ms\": %.3f, \"ours_floor_median_ms\": %.3f, \"ours_manhattan_median_ms\": %.3f, "
-                "\"ours_classification_median_ms\": %.3f, \"reference_voxel_median_ms\": %.3f, "
-                "\"reference_normals_median_ms\": %.3f, \"reference_growing_median_ms\": %.3f, "
-                "\"reference_ransac_median_ms\": %.3f, \"reference_clusters_median_ms\": %.3f, "
-                "\"ours_floor_found\": %d, \"reference_floor_found\": %d, \"ours_regions_median\": %.0f, "
-                "\"reference_regions_median\": %.0f}\n",
-                frames.size(), W, H, med, p95, cmed, cp95, rmed, rp95, rcmed, ratio, cratio, percentile(o_seg, 0.5),
-                percentile(o_floor, 0.5), percentile(o_man, 0.5), percentile(o_cls, 0.5), percentile(r_vox, 0.5),
-                percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5), percentile(r_clu, 0.5),
-                floors, ref_floors, percentile(o_regions, 0.5), percentile(r_regions, 0.5));
+    std::printf(
+        "{\"frames\": %zu, \"width\": %d, \"height\": %d, \"ours_median_ms\": %.3f, \"ours_p95_ms\": %.3f, "
+        "\"ours_cpu_median_ms\": %.3f, \"ours_cpu_p95_ms\": %.3f, \"reference_median_ms\": %.3f, "
+        "\"reference_p95_ms\": %.3f, \"reference_cpu_median_ms\": %.3f, \"ratio\": %.2f, \"cpu_ratio\": "
+        "%.2f, "
+        "\"ours_segmentation_median_ms\": %.3f, \"ours_floor_median_ms\": %.3f, "
+        "\"ours_manhattan_median_ms\": %.3f, "
+        "\"ours_classification_median_ms\": %.3f, \"reference_voxel_median_ms\": %.3f, "
+        "\"reference_normals_median_ms\": %.3f, \"reference_growing_median_ms\": %.3f, "
+        "\"reference_ransac_median_ms\": %.3f, \"reference_clusters_median_ms\": %.3f, "
+        "\"ours_floor_found\": %d, \"reference_floor_found\": %d, \"ours_regions_median\": %.0f, "
+        "\"reference_regions_median\": %.0f}\n",
+        frames.size(), W, H, med, p95, cmed, cp95, rmed, rp95, rcmed, ratio, cratio, percentile(o_seg, 0.5),
+        percentile(o_floor, 0.5), percentile(o_man, 0.5), percentile(o_cls, 0.5), percentile(r_vox, 0.5),
+        percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5), percentile(r_clu, 0.5),
+        floors, ref_floors, percentile(o_regions, 0.5), percentile(r_regions, 0.5));
     return 0;
   }
   std::printf("perception bench: %zu frames %dx%d, one thread\n", frames.size(), W, H);
-  std::printf("  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d | regions median %.0f\n", med,
-              p95, cmed, cp95, floors, percentile(o_regions, 0.5));
-  std::printf("    segmentation %.3f (backproject %.3f, seeds+growing %.3f [cells %.3f, fine seeds %.3f, strips+splits %.3f], "
-              "merge %.3f, borders %.3f, regions %.3f, clusters %.3f)  floor %.3f  manhattan %.3f  classification %.3f\n",
-              percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_cells, 0.5),
-              percentile(s_seeds, 0.5), percentile(s_strips, 0.5), percentile(s_merge, 0.5),
-              percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
-              percentile(o_man, 0.5), percentile(o_cls, 0.5));
-  std::printf("  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d | regions median %.0f\n", rmed,
-              rp95, rcmed, ref_floors, percentile(r_regions, 0.5));
+  std::printf(
+      "  ours       wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms  p95 %8.3f ms | floor on %d | "
+      "regions median %.0f\n",
+      med, p95, cmed, cp95, floors, percentile(o_regions, 0.5));
+  std::printf(
+      "    segmentation %.3f (backproject %.3f, seeds+growing %.3f [cells %.3f, fine seeds %.3f, "
+      "strips+splits %.3f], "
+      "merge %.3f, borders %.3f, regions %.3f, clusters %.3f)  floor %.3f  manhattan %.3f  classification "
+      "%.3f\n",
+      percentile(o_seg, 0.5), percentile(s_bp, 0.5), percentile(s_grow, 0.5), percentile(s_cells, 0.5),
+      percentile(s_seeds, 0.5), percentile(s_strips, 0.5), percentile(s_merge, 0.5),
+      percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
+      percentile(o_man, 0.5), percentile(o_cls, 0.5));
+  std::printf(
+      "  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d | regions median "
+      "%.0f\n",
+      rmed, rp95, rcmed, ref_floors, percentile(r_regions, 0.5));
   std::printf("    voxel %.3f  normals %.3f  region growing %.3f  ransac %.3f  euclidean clusters %.3f\n",
-              percentile(r_vox, 0.5), percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5),
-              percentile(r_clu, 0.5));
+              percentile(r_vox, 0.5), percentile(r_norm, 0.5), percentile(r_grow, 0.5),
+              percentile(r_ransac, 0.5), percentile(r_clu, 0.5));
   std::printf("  ratio (reference / ours, medians): wall %.1fx  cpu %.1fx\n", ratio, cratio);
   return 0;
 }

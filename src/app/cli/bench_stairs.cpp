@@ -17,8 +17,8 @@
 namespace stairguide::cli {
 namespace {
 
-std::vector<double> time_stage(StairStage& stage, const std::vector<SceneResult>& scenes, const CameraIntrinsics& K,
-                               int repeat, int& detected) {
+std::vector<double> time_stage(StairStage& stage, const std::vector<SceneResult>& scenes,
+                               const CameraIntrinsics& K, int repeat, int& detected) {
   std::vector<double> ms;
   StairResult r;
   for (const auto& s : scenes) stage.run(s, K, r);  // warm-up: buffers reach their size
@@ -71,21 +71,23 @@ int bench_stairs(Context& ctx) {
   const double rmed = percentile(t_ref, 0.5), rp95 = percentile(t_ref, 0.95);
   const double ratio = med > 0 ? rmed / med : 0.0;
   if (json) {
-    std::printf("{\"median_ms\": %.4f, \"p95_ms\": %.4f, \"max_ms\": %.4f, \"frames\": %zu, \"repeat\": %ld, "
-                "\"detected\": %d, \"reference_median_ms\": %.4f, \"reference_p95_ms\": %.4f, "
-                "\"reference_detected\": %d, \"ratio\": %.3f, \"step_candidates_per_frame\": %.2f, "
-                "\"regions_per_frame\": %.2f}\n",
-                med, p95, percentile(t_ours, 1.0), scenes.size(), repeat, det_ours, rmed, rp95, det_ref, ratio,
-                static_cast<double>(candidates) / static_cast<double>(scenes.size()),
-                static_cast<double>(regions) / static_cast<double>(scenes.size()));
+    std::printf(
+        "{\"median_ms\": %.4f, \"p95_ms\": %.4f, \"max_ms\": %.4f, \"frames\": %zu, \"repeat\": %ld, "
+        "\"detected\": %d, \"reference_median_ms\": %.4f, \"reference_p95_ms\": %.4f, "
+        "\"reference_detected\": %d, \"ratio\": %.3f, \"step_candidates_per_frame\": %.2f, "
+        "\"regions_per_frame\": %.2f}\n",
+        med, p95, percentile(t_ours, 1.0), scenes.size(), repeat, det_ours, rmed, rp95, det_ref, ratio,
+        static_cast<double>(candidates) / static_cast<double>(scenes.size()),
+        static_cast<double>(regions) / static_cast<double>(scenes.size()));
     return 0;
   }
   std::printf("stair detection + modelling, %zu frames (%ld per preset) x %ld runs, perception not timed\n",
               scenes.size(), per_preset, repeat);
   std::printf("  ours:      median %.3f ms  p95 %.3f ms  max %.3f ms  (%d frames with a stair)\n", med, p95,
               percentile(t_ours, 1.0), det_ours);
-  std::printf("  reference: median %.3f ms  p95 %.3f ms  (exhaustive connection test, %d frames with a stair)\n",
-              rmed, rp95, det_ref);
+  std::printf(
+      "  reference: median %.3f ms  p95 %.3f ms  (exhaustive connection test, %d frames with a stair)\n",
+      rmed, rp95, det_ref);
   std::printf("  ratio reference/ours (median): %.2fx\n", ratio);
   std::printf("  %.1f regions, %.1f step candidates per frame\n",
               static_cast<double>(regions) / static_cast<double>(scenes.size()),

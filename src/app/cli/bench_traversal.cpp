@@ -77,16 +77,16 @@ int bench_traversal(Context& ctx) {
         "{\"median_ms\": %.4f, \"p95_ms\": %.4f, \"max_ms\": %.4f, \"frames\": %d, \"frames_on_stairs\": %d, "
         "\"holding_median_ms\": %.4f, \"holding_frames\": %zu, \"reference_median_ms\": %.4f, "
         "\"reference\": \"stairs stage\", \"ratio\": %.3f, \"goal_ms\": 1.0}\n",
-        med, p95, percentile(tracker_ms, 1.0), frames, on_stairs, percentile(holding_ms, 0.5), holding_ms.size(), rmed,
-        med > 0 ? rmed / med : 0.0);
+        med, p95, percentile(tracker_ms, 1.0), frames, on_stairs, percentile(holding_ms, 0.5),
+        holding_ms.size(), rmed, med > 0 ? rmed / med : 0.0);
     return 0;
   }
   std::printf("traversal tracker, %d frames of %zu walk(s) at %.0f Hz (%d on the flight), thread CPU time\n",
               frames, walks.size(), fps, on_stairs);
   std::printf("  tracker:   median %.4f ms  p95 %.4f ms  max %.4f ms  (goal: median <= 1 ms)\n", med, p95,
               percentile(tracker_ms, 1.0));
-  std::printf("  tracker, frames with a staircase held (%zu): median %.4f ms  p95 %.4f ms\n", holding_ms.size(),
-              percentile(holding_ms, 0.5), percentile(holding_ms, 0.95));
+  std::printf("  tracker, frames with a staircase held (%zu): median %.4f ms  p95 %.4f ms\n",
+              holding_ms.size(), percentile(holding_ms, 0.5), percentile(holding_ms, 0.95));
   std::printf("  reference: stairs stage on the same frames, median %.3f ms (%.0fx the tracker)\n", rmed,
               med > 0 ? rmed / med : 0.0);
   return 0;

@@ -16,7 +16,8 @@ namespace {
 int bench(Context& ctx) {
   if (ctx.args.empty() || ctx.args[0].rfind("--", 0) == 0) {
     std::string names;
-    for (const auto& b : bench_registry()) names += std::string("\n  stairguide bench ") + b.usage + "  " + b.summary;
+    for (const auto& b : bench_registry())
+      names += std::string("\n  stairguide bench ") + b.usage + "  " + b.summary;
     throw UsageError("which benchmark?" + names);
   }
   const std::string what = ctx.args[0];
@@ -31,6 +32,7 @@ int bench(Context& ctx) {
 
 }  // namespace
 
-SG_COMMAND("bench", "bench WHAT [--json] ...", "benchmarks: medians and ratios against a reference in the same run", bench);
+SG_COMMAND("bench", "bench WHAT [--json] ...",
+           "benchmarks: medians and ratios against a reference in the same run", bench);
 
 }  // namespace stairguide::cli

@@ -34,7 +34,9 @@ int dump_config(Context& ctx) {
 
 }  // namespace
 
-SG_COMMAND("check-config", "check-config [FILE]", "validate a config file; exit 0 or name the problem", check_config);
-SG_COMMAND("dump-config", "dump-config [--defaults]", "print the effective config as commented YAML", dump_config);
+SG_COMMAND("check-config", "check-config [FILE]", "validate a config file; exit 0 or name the problem",
+           check_config);
+SG_COMMAND("dump-config", "dump-config [--defaults]", "print the effective config as commented YAML",
+           dump_config);
 
 }  // namespace stairguide::cli

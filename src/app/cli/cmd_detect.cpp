@@ -22,7 +22,9 @@ namespace {
 std::string fmt(double v) { return json_number(v); }
 const auto& quote = json_quote;
 
-std::string vec3(const Eigen::Vector3f& v) { return "[" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + "]"; }
+std::string vec3(const Eigen::Vector3f& v) {
+  return "[" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + "]";
+}
 
 std::string mat4(const Pose& T) {
   const Eigen::Matrix4f M = T.matrix();
@@ -61,8 +63,8 @@ int detect(Context& ctx) {
   for (long i = 0; i <= frame_no; ++i) {
     const ReadResult rr = source->read(frame);
     if (!rr.ok()) {
-      std::fprintf(stderr, "stairguide detect: cannot read frame %ld of %s: %s\n", i, source->describe().c_str(),
-                   rr.message.empty() ? "end of input" : rr.message.c_str());
+      std::fprintf(stderr, "stairguide detect: cannot read frame %ld of %s: %s\n", i,
+                   source->describe().c_str(), rr.message.empty() ? "end of input" : rr.message.c_str());
       return 1;
     }
     if (independent && i < frame_no) continue;
@@ -86,7 +88,8 @@ int detect(Context& ctx) {
       return 1;
     }
     if (!ok) {
-      std::fprintf(stderr, "stairguide detect: cannot write %s (unknown extension or unwritable folder)\n", png->c_str());
+      std::fprintf(stderr, "stairguide detect: cannot write %s (unknown extension or unwritable folder)\n",
+                   png->c_str());
       return 1;
     }
   }
@@ -126,34 +129,39 @@ int detect(Context& ctx) {
       kv("floorless", "{\"up_found\": " + std::string(t.up_found ? "true" : "false") +
                           ", \"tilt_deg\": " + fmt(rad2deg(t.tilt)) + ", \"levels\": " + fmt(t.levels) +
                           ", \"stacked\": " + fmt(t.stacked) + ", \"direction\": " + fmt(t.direction) +
-                          ", \"level_heights_m\": " + heights + "], \"near_distances_m\": " + near + "], \"first_near_cut\": " +
-                          (t.first_near_cut ? "true" : "false") + ", \"first_depth_m\": " + fmt(t.first_depth) + ", \"floor_level\": " +
-                          (t.floor_level ? "true" : "false") + ", \"floor_seen\": " + (t.floor_seen ? "true" : "false") +
+                          ", \"level_heights_m\": " + heights + "], \"near_distances_m\": " + near +
+                          "], \"first_near_cut\": " + (t.first_near_cut ? "true" : "false") +
+                          ", \"first_depth_m\": " + fmt(t.first_depth) +
+                          ", \"floor_level\": " + (t.floor_level ? "true" : "false") +
+                          ", \"floor_seen\": " + (t.floor_seen ? "true" : "false") +
                           ", \"floor_beside\": " + (t.floor_beside ? "true" : "false") +
                           ", \"landing_split\": " + (t.landing_split ? "true" : "false") +
                           ", \"riser_against\": " + (t.riser_against ? "true" : "false") +
-                          ", \"anchored\": " + (t.anchored ? "true" : "false") + ", \"first_index\": " +
-                          fmt(t.first_index) + "}");
+                          ", \"anchored\": " + (t.anchored ? "true" : "false") +
+                          ", \"first_index\": " + fmt(t.first_index) + "}");
     }
     kv("candidates", fmt(result.candidates));
     kv("rejected_candidates", fmt(result.rejected_candidates));
-    kv("timings_ms", "{\"perception\": " + fmt(perception_ms) + ", \"detection\": " +
-                         fmt(result.timings.detection_ms) + ", \"modelling\": " + fmt(result.timings.modelling_ms) +
+    kv("timings_ms", "{\"perception\": " + fmt(perception_ms) +
+                         ", \"detection\": " + fmt(result.timings.detection_ms) +
+                         ", \"modelling\": " + fmt(result.timings.modelling_ms) +
                          ", \"stairs\": " + fmt(result.timings.total_ms) + "}");
     if (truth) {
       const StairFrameEval e = evaluate_stair_frame(result, *truth);
       std::string stairs = "[";
       for (const auto& st : truth->stairs) {
         if (stairs.size() > 1) stairs += ", ";
-        stairs += "{\"kind\": " + quote(to_string(st.kind)) + ", \"direction\": " +
-                  quote(st.goes_down() ? "down" : "up") + ", \"riser_m\": " + fmt(st.riser_m) +
-                  ", \"tread_m\": " + fmt(st.tread_m) + ", \"width_m\": " + fmt(st.width_m) +
+        stairs += "{\"kind\": " + quote(to_string(st.kind)) +
+                  ", \"direction\": " + quote(st.goes_down() ? "down" : "up") +
+                  ", \"riser_m\": " + fmt(st.riser_m) + ", \"tread_m\": " + fmt(st.tread_m) +
+                  ", \"width_m\": " + fmt(st.width_m) +
                   ", \"visible_steps\": " + fmt(static_cast<double>(st.visible_steps.size())) +
-                  ", \"user_step\": " + fmt(st.user_step) + ", \"T_camera_stair\": " + mat4(st.T_camera_stair) + "}";
+                  ", \"user_step\": " + fmt(st.user_step) +
+                  ", \"T_camera_stair\": " + mat4(st.T_camera_stair) + "}";
       }
-      kv("truth", "{\"kind\": " + quote(to_string(e.truth_kind)) + ", \"visible_steps\": " +
-                      fmt(e.truth_visible_steps) + ", \"outcome\": " + quote(to_string(e.outcome)) +
-                      ", \"stairs\": " + stairs + "]}");
+      kv("truth", "{\"kind\": " + quote(to_string(e.truth_kind)) +
+                      ", \"visible_steps\": " + fmt(e.truth_visible_steps) +
+                      ", \"outcome\": " + quote(to_string(e.outcome)) + ", \"stairs\": " + stairs + "]}");
     }
     std::printf("%s}\n", o.c_str());
     return 0;
@@ -164,8 +172,9 @@ int detect(Context& ctx) {
   if (result.detected) {
     const Eigen::Vector3f o = result.origin();
     std::printf("stair: %s (%s), %d levels seen, riser %.1f cm, tread %.1f cm, width %.1f cm, axes by %s\n",
-                to_string(result.kind), direction_name(result.direction()), result.levels, 100.f * result.riser_m, 100.f * result.tread_m,
-                100.f * result.width_m, to_string(result.method));
+                to_string(result.kind), direction_name(result.direction()), result.levels,
+                100.f * result.riser_m, 100.f * result.tread_m, 100.f * result.width_m,
+                to_string(result.method));
     std::printf("building code: %s\n", code_notes_text(result.code_notes).c_str());
     std::printf("first edge centre (camera frame): %.3f %.3f %.3f m\n", o.x(), o.y(), o.z());
   } else {

@@ -92,7 +92,8 @@ void judge_held_by_daemon(Check& c, const std::vector<int>& pids) {
   if (!held) return;
   c.status = Status::kInfo;
   c.message = "in use by the running daemon (pid " + std::to_string(pids.front()) +
-              "), so not tried here: " + c.message + "; stop the daemon ('sudo systemctl stop stairguide') and "
+              "), so not tried here: " + c.message +
+              "; stop the daemon ('sudo systemctl stop stairguide') and "
               "run the doctor again to try it";
   c.fix.clear();
 }
@@ -104,8 +105,9 @@ Check check_config(const std::string& path, PipelineConfig& config) {
   if (path.empty()) {
     c.status = Status::kFail;
     c.message = "no config file found ($STAIRGUIDE_CONFIG unset, no /etc/stairguide/stairguide.yaml)";
-    c.fix = "install the package (it puts the config in /etc/stairguide/stairguide.yaml), or name one with "
-            "--config FILE; the checks below use the built-in defaults";
+    c.fix =
+        "install the package (it puts the config in /etc/stairguide/stairguide.yaml), or name one with "
+        "--config FILE; the checks below use the built-in defaults";
     return c;
   }
   ConfigLoadReport report;
@@ -114,14 +116,16 @@ Check check_config(const std::string& path, PipelineConfig& config) {
   } catch (const ConfigError& e) {
     c.status = Status::kFail;
     c.message = std::string("the config does not load: ") + e.what();
-    c.fix = "edit " + path + " at the line and key named (every key, its unit and range are listed by "
-            "'stairguide dump-config --defaults'), then run 'stairguide check-config " + path +
-            "'; the checks below use the built-in defaults";
+    c.fix = "edit " + path +
+            " at the line and key named (every key, its unit and range are listed by "
+            "'stairguide dump-config --defaults'), then run 'stairguide check-config " +
+            path + "'; the checks below use the built-in defaults";
     return c;
   }
   c.message = path + " loads and every value is valid";
   if (!report.missing_keys.empty())
-    c.message += " (" + std::to_string(report.missing_keys.size()) + " keys not given: their defaults are used)";
+    c.message +=
+        " (" + std::to_string(report.missing_keys.size()) + " keys not given: their defaults are used)";
   return c;
 }
 
@@ -143,8 +147,10 @@ Check check_camera(const CaptureConfig& cfg) {
     }
     if (!r.ok() || !f.has_depth()) {
       c.status = Status::kFail;
-      c.message = cam.describe() + " opened but sent no depth frame" + (r.message.empty() ? "" : ": " + r.message);
-      c.fix = "unplug the camera and plug it in again (a USB 3 port can starve it: try a USB 2 port); " + fix_plug;
+      c.message =
+          cam.describe() + " opened but sent no depth frame" + (r.message.empty() ? "" : ": " + r.message);
+      c.fix = "unplug the camera and plug it in again (a USB 3 port can starve it: try a USB 2 port); " +
+              fix_plug;
       return c;
     }
     int valid = cv::countNonZero(f.depth > 0);
@@ -176,7 +182,8 @@ bool no_sound_card() {
   std::ifstream f("/proc/asound/cards");
   if (!f) return true;
   std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  return all.find("no soundcards") != std::string::npos || all.find_first_not_of(" \n\t") == std::string::npos;
+  return all.find("no soundcards") != std::string::npos ||
+         all.find_first_not_of(" \n\t") == std::string::npos;
 }
 
 Check check_sound(const FeedbackConfig& cfg) {
@@ -191,8 +198,8 @@ Check check_sound(const FeedbackConfig& cfg) {
   std::vector<std::int16_t> tone(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     const double fade = std::min(1.0, std::min(i, n - 1 - i) / (0.02 * feedback::kSoundRate));
-    tone[static_cast<std::size_t>(i)] = static_cast<std::int16_t>(
-        std::lround(12000.0 * cfg.volume * fade * std::sin(2 * 3.14159265358979 * 880.0 * i / feedback::kSoundRate)));
+    tone[static_cast<std::size_t>(i)] = static_cast<std::int16_t>(std::lround(
+        12000.0 * cfg.volume * fade * std::sin(2 * 3.14159265358979 * 880.0 * i / feedback::kSoundRate)));
   }
   feedback::SoundBank bank;
   bank.clips["doctor_tone"] = tone;
@@ -233,10 +240,12 @@ Check check_sound(const FeedbackConfig& cfg) {
   }
   // The sink's warning goes on about retrying: what matters here is what failed.
   if (c.message.rfind("audio: ", 0) == 0) c.message.erase(0, 7);
-  if (const auto at = c.message.find("; going on without sound"); at != std::string::npos) c.message.resize(at);
+  if (const auto at = c.message.find("; going on without sound"); at != std::string::npos)
+    c.message.resize(at);
   if (no_sound_card()) c.message += " (this machine has no sound card: /proc/asound/cards lists none)";
-  c.fix = "plug in the headphones or USB sound card the wearer uses; 'aplay -L' lists the ALSA devices: "
-          "set feedback.audio_device to the one to use (e.g. \"plughw:CARD=Device\") and run the doctor again";
+  c.fix =
+      "plug in the headphones or USB sound card the wearer uses; 'aplay -L' lists the ALSA devices: "
+      "set feedback.audio_device to the one to use (e.g. \"plughw:CARD=Device\") and run the doctor again";
   return c;
 }
 
@@ -250,8 +259,9 @@ Check check_buzzer(const FeedbackConfig& cfg) {
     return c;
   }
   const bool file = cfg.gpio_chip.rfind("file:", 0) == 0;  // a test buzzer writing its edges to a file
-  const std::string where = file ? "the buzzer's edge file " + cfg.gpio_chip.substr(5) + " (a test buzzer)"
-                                 : "GPIO line " + std::to_string(cfg.gpio_line) + " of '" + cfg.gpio_chip + "'";
+  const std::string where =
+      file ? "the buzzer's edge file " + cfg.gpio_chip.substr(5) + " (a test buzzer)"
+           : "GPIO line " + std::to_string(cfg.gpio_line) + " of '" + cfg.gpio_chip + "'";
   try {
     auto line = feedback::make_haptic_line(cfg.gpio_chip, cfg.gpio_line);
     line->set(true);  // one 150 ms pulse: the helper can feel that this is the right line
@@ -264,9 +274,10 @@ Check check_buzzer(const FeedbackConfig& cfg) {
     std::string why = e.what();
     if (why.rfind("haptic: ", 0) == 0) why.erase(0, 8);
     c.message = "cannot use the buzzer: " + why;
-    c.fix = "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.gpio_chip and "
-            "feedback.gpio_line to the buzzer's (or feedback.haptic_enabled: false for none); a line "
-            "'used' by another program must be freed first";
+    c.fix =
+        "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.gpio_chip and "
+        "feedback.gpio_line to the buzzer's (or feedback.haptic_enabled: false for none); a line "
+        "'used' by another program must be freed first";
   }
   return c;
 }
@@ -276,20 +287,24 @@ Check check_buzzer(const FeedbackConfig& cfg) {
 Check check_button(const FeedbackConfig& cfg) {
   Check c{"button"};
   const bool file = cfg.button_chip.rfind("file:", 0) == 0;  // a test button reading presses from a file
-  const std::string where = file ? "the button's presses file " + cfg.button_chip.substr(5) + " (a test button)"
-                                 : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
+  const std::string where =
+      file ? "the button's presses file " + cfg.button_chip.substr(5) + " (a test button)"
+           : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
   try {
-    const auto line = feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
-    c.message = where + (file ? " opened" : " requested for its edges") +
-                ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
+    const auto line =
+        feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
+    c.message =
+        where + (file ? " opened" : " requested for its edges") +
+        ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
   } catch (const std::exception& e) {
     c.status = Status::kFail;
     std::string why = e.what();
     if (why.rfind("button: ", 0) == 0) why.erase(0, 8);
     c.message = "cannot use the button: " + why;
-    c.fix = "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.button_chip and "
-            "feedback.button_line to the button's (or feedback.button_enabled: false for none); the user must "
-            "be in group gpio";
+    c.fix =
+        "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.button_chip and "
+        "feedback.button_line to the button's (or feedback.button_enabled: false for none); the user must "
+        "be in group gpio";
   }
   return c;
 }
@@ -357,7 +372,8 @@ std::vector<std::string> camera_usb_nodes() {
     const std::string bus = read("busnum"), dev = read("devnum");
     if (bus.empty() || dev.empty()) continue;
     char path[64];
-    std::snprintf(path, sizeof path, "/dev/bus/usb/%03d/%03d", std::atoi(bus.c_str()), std::atoi(dev.c_str()));
+    std::snprintf(path, sizeof path, "/dev/bus/usb/%03d/%03d", std::atoi(bus.c_str()),
+                  std::atoi(dev.c_str()));
     out.push_back(path);
   }
   return out;
@@ -378,8 +394,9 @@ Check check_user(const std::string& name, const std::string& config_path, bool i
   if (!find_user(name, id)) {
     c.status = Status::kFail;
     c.message = "the service user '" + name + "' does not exist: the service cannot start";
-    c.fix = "install the stairguide package (it creates the user), or run 'sudo systemd-sysusers' with "
-            "systemd/stairguide.sysusers installed as /usr/lib/sysusers.d/stairguide.conf";
+    c.fix =
+        "install the stairguide package (it creates the user), or run 'sudo systemd-sysusers' with "
+        "systemd/stairguide.sysusers installed as /usr/lib/sysusers.d/stairguide.conf";
     return c;
   }
   std::vector<std::string> problems, fixes;
@@ -406,19 +423,23 @@ Check check_user(const std::string& name, const std::string& config_path, bool i
   };
   std::vector<Node> nodes;
   for (const auto& p : glob_dev("/dev/snd", std::regex("pcmC\\d+D\\d+p|controlC\\d+")))
-    nodes.push_back({p, "the sound card", "Debian gives /dev/snd to group audio: 'sudo udevadm trigger --subsystem-match=sound'"});
+    nodes.push_back({p, "the sound card",
+                     "Debian gives /dev/snd to group audio: 'sudo udevadm trigger --subsystem-match=sound'"});
   for (const auto& p : glob_dev("/dev", std::regex("gpiochip\\d+")))
-    nodes.push_back({p, "the GPIO chip",
-                     "the package's udev rule gives it to group gpio: 'sudo udevadm control --reload && sudo udevadm "
-                     "trigger --subsystem-match=gpio'"});
+    nodes.push_back(
+        {p, "the GPIO chip",
+         "the package's udev rule gives it to group gpio: 'sudo udevadm control --reload && sudo udevadm "
+         "trigger --subsystem-match=gpio'"});
   for (const auto& p : camera_usb_nodes())
-    nodes.push_back({p, "the camera",
-                     "OpenNI2's udev rule (package libopenni2-0) gives it to group video: replug the camera"});
+    nodes.push_back(
+        {p, "the camera",
+         "OpenNI2's udev rule (package libopenni2-0) gives it to group video: replug the camera"});
   for (const auto& n : nodes) {
     struct stat st {};
     if (stat(n.path.c_str(), &st) != 0) continue;
     if (!may(id, st, 6)) {
-      problems.push_back("'" + name + "' cannot open " + n.path + " (" + n.what + ", " + owner_text(st) + ")");
+      problems.push_back("'" + name + "' cannot open " + n.path + " (" + n.what + ", " + owner_text(st) +
+                         ")");
       fixes.push_back(n.fix);
     }
   }
@@ -457,9 +478,11 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
   const std::string dir = cfg.sounds_dir;
   if (!fs::is_directory(dir)) {
     c.status = Status::kFail;
-    c.message = "the sounds folder " + dir + " (feedback.sounds_dir) does not exist: every spoken cue would be silent";
-    c.fix = "set feedback.sounds_dir to the folder of the cues: the package puts them in "
-            "/usr/share/stairguide/sounds ('cmake --install' in PREFIX/share/stairguide/sounds)";
+    c.message = "the sounds folder " + dir +
+                " (feedback.sounds_dir) does not exist: every spoken cue would be silent";
+    c.fix =
+        "set feedback.sounds_dir to the folder of the cues: the package puts them in "
+        "/usr/share/stairguide/sounds ('cmake --install' in PREFIX/share/stairguide/sounds)";
     return c;
   }
   // The words of the configured language (feedback.language), the earcons from the folder itself.
@@ -500,14 +523,18 @@ Check check_sounds(const FeedbackConfig& cfg, const std::string& user) {
     c.status = Status::kFail;
     c.message = std::to_string(problems.size()) + " of the " + std::to_string(names.size()) +
                 " cues the daemon speaks cannot be used: " + problems.front();
-    for (std::size_t i = 1; i < std::min<std::size_t>(problems.size(), 4); ++i) c.message += "; " + problems[i];
+    for (std::size_t i = 1; i < std::min<std::size_t>(problems.size(), 4); ++i)
+      c.message += "; " + problems[i];
     if (problems.size() > 4) c.message += "; ...";
-    c.fix = "reinstall the package (sudo apt-get install --reinstall stairguide) or copy the WAVs of the "
-            "source tree's sounds/ into " + dir + " (16-bit mono, readable by everyone)";
+    c.fix =
+        "reinstall the package (sudo apt-get install --reinstall stairguide) or copy the WAVs of the "
+        "source tree's sounds/ into " +
+        dir + " (16-bit mono, readable by everyone)";
     return c;
   }
   c.message = "all " + std::to_string(names.size()) + " cues are in " + dir +
-              (set.speech_dir != dir ? " (the words in " + set.speech_dir + ")" : std::string()) + " and readable";
+              (set.speech_dir != dir ? " (the words in " + set.speech_dir + ")" : std::string()) +
+              " and readable";
   return c;
 }
 
@@ -545,11 +572,13 @@ Check check_rig() {
     if (std::regex_search(rig, m, std::regex("frame (\\d+): rig (learned|relearned): (.*)$")))
       c.message += "; rig " + m[2].str() + " at frame " + m[1].str() + ": " + m[3].str();
     else if (geteuid() != 0 && rig.empty())
-      c.message += "; the rig it learned is in the journal, which this user may not read: run 'sudo "
-                   "stairguide doctor' to see it";
+      c.message +=
+          "; the rig it learned is in the journal, which this user may not read: run 'sudo "
+          "stairguide doctor' to see it";
     else
-      c.message += "; no rig learned yet: the daemon learns the camera's height and tilt from its first "
-                   "clear views of the floor";
+      c.message +=
+          "; no rig learned yet: the daemon learns the camera's height and tilt from its first "
+          "clear views of the floor";
     return c;
   }
   const std::vector<int> pids = daemon_pids();
@@ -586,7 +615,8 @@ int doctor(Context& ctx) {
     if (!json) {
       const char* tag = c.status == Status::kOk ? "[ ok ]" : c.status == Status::kFail ? "[FAIL]" : "[info]";
       std::printf("%s %-7s %s\n", tag, c.name.c_str(), c.message.c_str());
-      if (c.status == Status::kFail && !c.fix.empty()) std::printf("       %-7s fix: %s\n", "", c.fix.c_str());
+      if (c.status == Status::kFail && !c.fix.empty())
+        std::printf("       %-7s fix: %s\n", "", c.fix.c_str());
       std::fflush(stdout);
     }
     checks.push_back(std::move(c));

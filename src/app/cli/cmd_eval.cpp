@@ -100,9 +100,10 @@ struct Runner {
                     scene.floor_found ? (scene.floor_tracked ? "tracked" : "found") : "none",
                     scene.floor_found ? scene.camera_height : 0.f, truth.camera_height_m);
       if (told.detected || truth.drop_in_view)
-        std::printf("  drop: truth %s %.2f m %+.0f deg, got %s %.2f m %+.0f deg (%s)", truth.drop_in_view ? "yes" : "no",
-                    truth.drop_distance_m, rad2deg(truth.drop_bearing_rad), told.detected ? "yes" : "no",
-                    told.distance_m, rad2deg(told.bearing_rad), to_string(drop.verdict));
+        std::printf("  drop: truth %s %.2f m %+.0f deg, got %s %.2f m %+.0f deg (%s)",
+                    truth.drop_in_view ? "yes" : "no", truth.drop_distance_m, rad2deg(truth.drop_bearing_rad),
+                    told.detected ? "yes" : "no", told.distance_m, rad2deg(told.bearing_rad),
+                    to_string(drop.verdict));
       std::printf("\n");
     }
     ++index;
@@ -172,7 +173,8 @@ bool run_csv(Runner& run, const std::string& path, const PipelineConfig& config,
       return false;
     }
     FrameTruth truth;
-    truth.scene = "real:" + (f[1] == "stair" ? (f.size() > 2 && !f[2].empty() ? f[2] : std::string("stair")) : "none");
+    truth.scene =
+        "real:" + (f[1] == "stair" ? (f.size() > 2 && !f[2].empty() ? f[2] : std::string("stair")) : "none");
     if (f[1] == "stair") {
       StairTruth s;
       // A curb's kind does not say which way it goes: the file must (curb_up / curb_down).
@@ -181,7 +183,8 @@ bool run_csv(Runner& run, const std::string& path, const PipelineConfig& config,
         s.kind = StairKind::kCurb;
         s.down = kind == "curb_down";
       } else if (kind == "curb") {
-        error = path + ":" + std::to_string(line_no) + ": kind 'curb' needs its direction: curb_up or curb_down";
+        error =
+            path + ":" + std::to_string(line_no) + ": kind 'curb' needs its direction: curb_up or curb_down";
         return false;
       } else if (!parse_stair_kind(kind, s.kind) || s.kind == StairKind::kNone) {
         error = path + ":" + std::to_string(line_no) +
@@ -257,7 +260,8 @@ int eval(Context& ctx) {
 }  // namespace
 
 SG_COMMAND("eval", "eval INPUT... [--json] [--verbose]",
-           "score stair detection on labelled inputs: dataset folders, synth:PRESET[:FRAMES[:SEED[:NOISE]]], labels.csv",
+           "score stair detection on labelled inputs: dataset folders, synth:PRESET[:FRAMES[:SEED[:NOISE]]], "
+           "labels.csv",
            eval);
 
 }  // namespace stairguide::cli

@@ -23,9 +23,10 @@ int synth_cmd(Context& ctx) {
   const auto oni = ctx.option("--oni");
   ctx.positionals(0, 0);
   if (list) {
-    for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(), &synth::rig_presets(),
-                             &synth::world2_presets(), &synth::drop_presets()})
-      for (const auto& p : *l) std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
+    for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(),
+                          &synth::rig_presets(), &synth::world2_presets(), &synth::drop_presets()})
+      for (const auto& p : *l)
+        std::printf("%-30s %6ld  %s\n", p.name.c_str(), p.default_frames, p.summary.c_str());
     return 0;
   }
   if (!scene) throw UsageError("--scene NAME is required (see --list)");
@@ -33,8 +34,8 @@ int synth_cmd(Context& ctx) {
   const synth::PresetInfo* preset = synth::find_preset_info(*scene);
   if (!preset) {
     std::string names;
-    for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(), &synth::rig_presets(),
-                             &synth::world2_presets(), &synth::drop_presets()})
+    for (const auto* l : {&synth::presets(), &synth::world_presets(), &synth::walk_presets(),
+                          &synth::rig_presets(), &synth::world2_presets(), &synth::drop_presets()})
       for (const auto& p : *l) names += (names.empty() ? "" : ", ") + p.name;
     throw UsageError("unknown scene '" + *scene + "' (known: " + names + ")");
   }

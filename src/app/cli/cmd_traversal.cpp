@@ -118,7 +118,8 @@ struct Axes {
     cv::Mat up;
     cv::rotate(label, up, cv::ROTATE_90_COUNTERCLOCKWISE);
     const int lx = std::max(0, box.x - 62), ly = std::max(0, box.y + box.height / 2 - up.rows / 2);
-    if (lx + up.cols <= img.cols && ly + up.rows <= img.rows) up.copyTo(img(cv::Rect(lx, ly, up.cols, up.rows)));
+    if (lx + up.cols <= img.cols && ly + up.rows <= img.rows)
+      up.copyTo(img(cv::Rect(lx, ly, up.cols, up.rows)));
   }
 };
 
@@ -133,7 +134,8 @@ void legend(cv::Mat& img, cv::Point corner, const std::vector<std::pair<cv::Scal
   for (std::size_t i = 0; i < items.size(); ++i) {
     const int y = corner.y + 16 + 20 * static_cast<int>(i);
     if (bars)
-      cv::rectangle(img, cv::Point(corner.x + 8, y - 9), cv::Point(corner.x + 34, y + 1), items[i].first, cv::FILLED);
+      cv::rectangle(img, cv::Point(corner.x + 8, y - 9), cv::Point(corner.x + 34, y + 1), items[i].first,
+                    cv::FILLED);
     else
       cv::line(img, cv::Point(corner.x + 8, y - 4), cv::Point(corner.x + 34, y - 4), items[i].first, 2);
     text(img, items[i].second, cv::Point(corner.x + 42, y));
@@ -145,8 +147,8 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
   const int W = 1000, H = 860;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   const cv::Scalar truth_c(200, 120, 0), odo_c(0, 0, 220), corr_c(0, 160, 0), stair_c(0, 0, 0);
-  text(img, "stairguide replay: the camera in the stair frame, corrected and by odometry alone", cv::Point(20, 28),
-       0.6, 2);
+  text(img, "stairguide replay: the camera in the stair frame, corrected and by odometry alone",
+       cv::Point(20, 28), 0.6, 2);
 
   // Top: the camera's y_S-z_S path against the stair profile (the paper's Fig. 19), one metre the
   // same length on both axes.
@@ -163,7 +165,8 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
   ymin = std::min(ymin, direction < 0 ? -r * static_cast<float>(n) - 0.1f : -r - 0.1f);
   zmin -= 0.1f, zmax += 0.1f, ymin -= 0.05f, ymax += 0.1f;
   const cv::Rect area(90, 60, W - 120, 420);
-  const double sc = std::min(area.width / std::max(0.1f, zmax - zmin), area.height / std::max(0.1f, ymax - ymin));
+  const double sc =
+      std::min(area.width / std::max(0.1f, zmax - zmin), area.height / std::max(0.1f, ymax - ymin));
   const int pw = static_cast<int>(sc * (zmax - zmin)), ph = static_cast<int>(sc * (ymax - ymin));
   Axes top{cv::Rect(area.x, area.y + area.height - ph, pw, ph), zmin, zmax, ymin, ymax};
   top.draw(img, "z_S: along the stair from its first edge (m)", "y_S: up (m)");
@@ -200,21 +203,22 @@ void draw_png(const std::string& path, const std::vector<Sample>& s, const Trave
 
   // Bottom: the gap along z_S to the truth the moment each step is reached (Fig. 20; needs the truth).
   const int gtop = 570;
-  text(img, "gap along z_S to the truth when each step is reached (the paper's Fig. 20)", cv::Point(20, gtop - 20),
-       0.55, 1);
+  text(img, "gap along z_S to the truth when each step is reached (the paper's Fig. 20)",
+       cv::Point(20, gtop - 20), 0.55, 1);
   double gmax = 0.05;
   std::vector<bool> done(static_cast<std::size_t>(std::max(steps, 0) + 1), false);
   std::vector<std::array<float, 2>> gaps(static_cast<std::size_t>(std::max(steps, 0) + 1), {NAN, NAN});
   for (const Sample& p : s) {
     if (p.t_step < 1 || p.t_step > steps || done[static_cast<std::size_t>(p.t_step)]) continue;
     done[static_cast<std::size_t>(p.t_step)] = true;
-    gaps[static_cast<std::size_t>(p.t_step)] = {std::fabs(p.cam_z - p.t_cam_z), std::fabs(p.u_cam_z - p.t_cam_z)};
+    gaps[static_cast<std::size_t>(p.t_step)] = {std::fabs(p.cam_z - p.t_cam_z),
+                                                std::fabs(p.u_cam_z - p.t_cam_z)};
     for (const float g : gaps[static_cast<std::size_t>(p.t_step)])
       if (std::isfinite(g)) gmax = std::max(gmax, static_cast<double>(g));
   }
   Axes bottom{cv::Rect(90, gtop, W - 120, H - gtop - 60), 0.5, std::max(steps, 1) + 0.5, 0.0, gmax * 1.5};
-  bottom.draw(img, steps > 0 ? "step reached" : "step reached (no truth in this input: no gaps)",
-              "gap (cm)", 1.0, 100.0);
+  bottom.draw(img, steps > 0 ? "step reached" : "step reached (no truth in this input: no gaps)", "gap (cm)",
+              1.0, 100.0);
   const double bw = 0.35;
   for (int k = 1; k <= steps; ++k)
     for (int i = 0; i < 2; ++i) {
@@ -259,8 +263,8 @@ class OutFile {
     const bool synced = std::fflush(f) == 0 && (fsync(fileno(f)) == 0 || errno == EINVAL || errno == EROFS);
     const int e = errno;
     if (std::fclose(f) != 0 || !synced)
-      throw std::runtime_error(path_ + ": cannot write the file to the disk (" + std::strerror(synced ? errno : e) +
-                               ")");
+      throw std::runtime_error(path_ + ": cannot write the file to the disk (" +
+                               std::strerror(synced ? errno : e) + ")");
   }
 
  private:
@@ -297,14 +301,15 @@ struct Drift {
   // The vertical from the first floor seen, in the odometry's own (undrifted) world.
   void see_floor(const SceneResult& scene) {
     if (have_up || !scene.floor_found) return;
-    up_world = (raw.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY()).normalized();
+    up_world =
+        (raw.linear() * scene.T_floor_camera.linear().transpose() * Eigen::Vector3f::UnitY()).normalized();
     have_up = true;
   }
 };
 
 // One frame's line of frames.jsonl.
-std::string frame_line(long n, const runtime::FrameObservation& ob, const TraversalResult& u, const Sample& sm,
-                       const StairTruth* st, float t_along) {
+std::string frame_line(long n, const runtime::FrameObservation& ob, const TraversalResult& u,
+                       const Sample& sm, const StairTruth* st, float t_along) {
   const runtime::OdometryOutput& o = ob.odometry;
   const runtime::PerceptionOutput& p = ob.perception;
   const TraversalResult& r = p.traversal;
@@ -314,12 +319,15 @@ std::string frame_line(long n, const runtime::FrameObservation& ob, const Traver
       "{\"frame\": " + std::to_string(n) + ", \"ts\": " + num(ob.frame.timestamp) +
       ", \"odom_ok\": " + std::to_string(o.ok ? 1 : 0) + ", \"perception\": " + json_quote(p.state) +
       ", \"manhattan\": " +
-      json_quote(!p.manhattan_found ? "none" : p.manhattan_carried ? "carried" : "seen") +
+      json_quote(!p.manhattan_found    ? "none"
+                 : p.manhattan_carried ? "carried"
+                                       : "seen") +
       ", \"detected\": " + std::to_string(stair.detected ? 1 : 0) +
       ", \"kind\": " + json_quote(to_string(stair.kind)) + ", \"levels\": " + std::to_string(stair.levels) +
       ", \"det_riser_m\": " + num(stair.riser_m) + ", \"det_tread_m\": " + num(stair.tread_m) +
-      ", \"state\": " + json_quote(r.ran ? to_string(r.state) : "-") + ", \"step\": " + std::to_string(r.step_index) +
-      ", \"left\": " + std::to_string(r.steps_left) + ", \"known\": " + std::to_string(r.steps_known) +
+      ", \"state\": " + json_quote(r.ran ? to_string(r.state) : "-") +
+      ", \"step\": " + std::to_string(r.step_index) + ", \"left\": " + std::to_string(r.steps_left) +
+      ", \"known\": " + std::to_string(r.steps_known) +
       ", \"last_known\": " + std::to_string(r.last_known ? 1 : 0) +
       ", \"in_view\": " + std::to_string(r.in_view ? 1 : 0) + ", \"distance_m\": " + num(r.distance_m) +
       ", \"riser_m\": " + num(r.riser_m) + ", \"tread_m\": " + num(r.tread_m) +
@@ -386,7 +394,9 @@ int replay(Context& ctx) {
   opt.frame_lines = false;
   opt.max_frames = max_frames ? *max_frames : -1;
   if (drift.on())
-    opt.pose_filter = [&](const RgbdFrame& f, runtime::OdometryOutput& o) { drift.apply(f.timestamp, o.T_world_camera); };
+    opt.pose_filter = [&](const RgbdFrame& f, runtime::OdometryOutput& o) {
+      drift.apply(f.timestamp, o.T_world_camera);
+    };
   opt.observer = [&](const runtime::FrameObservation& ob) {
     const runtime::OdometryOutput& o = ob.odometry;
     const TraversalResult& r = ob.perception.traversal;
@@ -422,7 +432,8 @@ int replay(Context& ctx) {
     const Eigen::Quaternionf q(T_wc.linear());
     char tl[200];
     std::snprintf(tl, sizeof tl, "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n", ob.frame.timestamp,
-                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(), q.w());
+                  T_wc.translation().x(), T_wc.translation().y(), T_wc.translation().z(), q.x(), q.y(), q.z(),
+                  q.w());
     traj.write(tl, what);
     ++n;
     if (total < 0) total = ob.source.frame_count();
@@ -443,7 +454,8 @@ int replay(Context& ctx) {
   traj.close();
   if (code != 0) {
     std::string why = rt.failure().empty() ? pos[0] + ": the replay failed" : rt.failure();
-    why += "; " + *out + "/frames.jsonl and trajectory.txt hold the " + std::to_string(n) + " frames before it";
+    why +=
+        "; " + *out + "/frames.jsonl and trajectory.txt hold the " + std::to_string(n) + " frames before it";
     try {
       if (n > 0) draw_png(*out + "/traversal.png", samples, last_model, steps, riser, tread, direction);
     } catch (const std::exception& e) {

@@ -64,7 +64,8 @@ struct BenchRegistrar {
   explicit BenchRegistrar(const Command& c) { bench_registry().push_back(c); }
 };
 
-#define SG_BENCH(name, usage, summary, fn) \
-  static const ::stairguide::cli::BenchRegistrar SG_COMMAND_CAT(sg_bench_, __LINE__)({name, usage, summary, fn})
+#define SG_BENCH(name, usage, summary, fn)                                 \
+  static const ::stairguide::cli::BenchRegistrar SG_COMMAND_CAT(sg_bench_, \
+                                                                __LINE__)({name, usage, summary, fn})
 
 }  // namespace stairguide::cli

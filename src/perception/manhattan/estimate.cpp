@@ -20,7 +20,8 @@ const EdgeCompassResult& ask_compass(std::optional<EdgeCompassResult>& cache,
 }
 }  // namespace
 
-ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions, const Pose& T_floor_camera,
+ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& regions,
+                                             const Pose& T_floor_camera,
                                              const std::function<EdgeCompassResult()>& compass) {
   ManhattanEstimate est;
   std::optional<EdgeCompassResult> compass_cache;
@@ -56,8 +57,9 @@ ManhattanEstimate ManhattanTracker::estimate(const std::vector<PlaneRegion>& reg
   if (!frame.found) return frame;
   find_vetoes(frame, riser_frame, bounding_only);
   if (!vetoes_.empty() && !apply_vetoes(frame, total_area, compass, compass_cache)) {
-    est.why = "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
-              "the room in front of it)";
+    est.why =
+        "a wall seen beyond the planes that make the frame disagrees with them (furniture turned against "
+        "the room in front of it)";
     est.fraction = frame.fraction;
     est.vertical_area = frame.vertical_area;
     return est;
@@ -131,7 +133,8 @@ float ManhattanTracker::collect_votes(const std::vector<PlaneRegion>& regions, c
   // Up in camera coordinates: the horizontal direction within a vertical plane is up x normal.
   view.up_c = view.R.transpose() * Eigen::Vector3f::UnitY();
   view.full_w = std::max(cfg_.yaw_full_width, 1e-3f);
-  view.clip_depth = max_range_ > 0.f ? max_range_ - cfg_.range_clip_margin : std::numeric_limits<float>::max();
+  view.clip_depth =
+      max_range_ > 0.f ? max_range_ - cfg_.range_clip_margin : std::numeric_limits<float>::max();
   float total_area = 0.f;
   std::vector<Vote>& votes = votes_;
   votes.clear();
@@ -316,7 +319,8 @@ bool ManhattanTracker::near_wall_agrees(float yaw, bool far_by_range) const {
   return false;
 }
 
-ManhattanEstimate ManhattanTracker::frame_of_planes(float total_area, bool& bounding_only, bool& riser_frame) {
+ManhattanEstimate ManhattanTracker::frame_of_planes(float total_area, bool& bounding_only,
+                                                    bool& riser_frame) {
   const std::vector<Vote>& votes = votes_;
   // Planes that bound the room (walls) make the frame when they can; the rest (furniture turned
   // against the room, risers, people) vote only when the bounding planes alone make no frame.
@@ -390,14 +394,16 @@ void ManhattanTracker::find_vetoes(const ManhattanEstimate& frame, bool riser_fr
     if (vf.width < cfg_.veto_min_width) continue;
     if (std::fabs(wrap_quarter(vf.a - frame.yaw)) <= disagree_tolerance(vf)) continue;
     // Not a wall when anything lies beyond it too.
-    if (vf.inside || (vf.has_side && area_beyond(vf, 0, struct_pts_.size()) >= cfg_.structure_beyond_area)) continue;
+    if (vf.inside || (vf.has_side && area_beyond(vf, 0, struct_pts_.size()) >= cfg_.structure_beyond_area))
+      continue;
     const std::size_t f0 = first[static_cast<std::size_t>(vf.region)];
     const std::size_t f1 = first[static_cast<std::size_t>(vf.region) + 1];
     for (const Vote& vn : votes) {
       if (&vn == &vf || !vn.has_side || vn.tilted) continue;
       if (bounding_only && vn.inside) continue;  // did not make this frame
       if (std::fabs(wrap_quarter(vn.a - frame.yaw)) > cfg_.cluster_tolerance) continue;
-      if (std::fabs(wrap_quarter(vf.a - vn.a)) <= std::max(disagree_tolerance(vn), disagree_tolerance(vf))) continue;
+      if (std::fabs(wrap_quarter(vf.a - vn.a)) <= std::max(disagree_tolerance(vn), disagree_tolerance(vf)))
+        continue;
       // Seen beyond it: structure_beyond_area of the wall, or half of a smaller wall (a strip of
       // wall 0.2 to 0.3 m wide seen past a sofa or shelves has 0.01 to 0.02 m^2 in view: synthetic
       // views 9 to 14 degrees off before).

@@ -10,7 +10,8 @@ void Segmentation::backproject(const RgbdFrame& frame) {
   K_ = frame.intrinsics;
   W_ = frame.depth.cols;
   H_ = frame.depth.rows;
-  div_magic_ = ((std::uint64_t(1) << 44) + static_cast<std::uint64_t>(W_) - 1) / static_cast<std::uint64_t>(W_);
+  div_magic_ =
+      ((std::uint64_t(1) << 44) + static_cast<std::uint64_t>(W_) - 1) / static_cast<std::uint64_t>(W_);
   const std::size_t n = static_cast<std::size_t>(W_) * static_cast<std::size_t>(H_);
   z_.resize(n);
   w_.resize(n);
@@ -161,7 +162,8 @@ float Segmentation::cell_first_w(int cu, int cv, int cs) const {
 }
 
 // The rest of a cell once its sums with w are known (n: count of valid pixels).
-void Segmentation::cell_finish(int cu, int cv, int cs, float w0, float n, float Sw, float Suw, float Svw, float Sww) {
+void Segmentation::cell_finish(int cu, int cv, int cs, float w0, float n, float Sw, float Suw, float Svw,
+                               float Sww) {
   if (n < cell_need_) return;
   const std::vector<float>& gu = gu_;
   const std::vector<float>& gv = gv_;
@@ -180,8 +182,11 @@ void Segmentation::cell_finish(int cu, int cv, int cs, float w0, float n, float 
       for (int i = 0; i < cs; ++i) {
         const float ok = w[i] > 0.f ? 1.f : 0.f;
         const float du = gu[i] * ok, dvv = dv * ok;
-        Su += du; Sv += dvv;
-        Suu += du * du; Suv += du * dvv; Svv += dvv * dvv;
+        Su += du;
+        Sv += dvv;
+        Suu += du * du;
+        Suv += du * dvv;
+        Svv += dvv * dvv;
       }
     }
   }
@@ -409,7 +414,8 @@ void Segmentation::select_cell_row(const CellCands& k, int v, int u0, int v0, in
   // computes the same float expression as the scalar loop below (same operations, same
   // order, no FMA): the choices are bit-identical.
   {
-    const __m128 vvv = _mm_set1_ps(vv), zero = _mm_setzero_ps(), tw4 = _mm_set1_ps(tw), neg = _mm_set1_ps(-1.f);
+    const __m128 vvv = _mm_set1_ps(vv), zero = _mm_setzero_ps(), tw4 = _mm_set1_ps(tw),
+                 neg = _mm_set1_ps(-1.f);
     const __m128 absmask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
     for (; u + 4 <= u0 + cs; u += 4) {
       const __m128 w = _mm_loadu_ps(wr + u);

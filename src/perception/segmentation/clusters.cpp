@@ -67,9 +67,11 @@ void Segmentation::extract_clusters(std::vector<ObstacleCluster>& clusters) {
     ObstacleCluster& c = clusters[out++];
     {
       // Points kept: every stride-th pixel both ways, about tail / stride^2 (a bound suffices).
-      const std::size_t need = static_cast<std::size_t>(tail) / static_cast<std::size_t>(stride * stride) + 64;
-      auto it = std::lower_bound(cluster_pool_.begin(), cluster_pool_.end(), need,
-                                 [](const std::vector<Eigen::Vector3f>& a, std::size_t k) { return a.capacity() < k; });
+      const std::size_t need =
+          static_cast<std::size_t>(tail) / static_cast<std::size_t>(stride * stride) + 64;
+      auto it = std::lower_bound(
+          cluster_pool_.begin(), cluster_pool_.end(), need,
+          [](const std::vector<Eigen::Vector3f>& a, std::size_t k) { return a.capacity() < k; });
       if (it == cluster_pool_.end() && !cluster_pool_.empty()) --it;
       if (it != cluster_pool_.end()) {
         c.points = std::move(*it);

@@ -75,7 +75,8 @@ std::size_t Segmentation::keep_regions(std::vector<Grow>& grows) {
   return out;
 }
 
-void Segmentation::hand_out_buffers(const std::vector<Grow>& grows, std::vector<PlaneRegion>& regions, std::size_t out) {
+void Segmentation::hand_out_buffers(const std::vector<Grow>& grows, std::vector<PlaneRegion>& regions,
+                                    std::size_t out) {
   const int n = static_cast<int>(grows.size());
   const std::vector<int>& map = order_;
   // The pixel and point buffers of the last frame's regions are pooled and handed out again,
@@ -205,7 +206,8 @@ void Segmentation::describe_region(PlaneRegion& R, std::size_t id, float area_k)
   R.cls = RegionClass::kUnclassified;
   R.height = std::numeric_limits<float>::quiet_NaN();
   // Footprint of one pixel on the plane: z^3 / (fx fy |n.p|), and n.p = -d on the plane.
-  R.area = static_cast<float>(A.z3 * (static_cast<double>(cnt) / np) * area_k / std::max(std::fabs(f.d), 0.01f));
+  R.area =
+      static_cast<float>(A.z3 * (static_cast<double>(cnt) / np) * area_k / std::max(std::fabs(f.d), 0.01f));
   const PlaneFit fu = fit_plane_pca(A.m);
   Eigen::Vector3f a1 = fu.ok ? Eigen::Vector3f(fu.eigenvectors.col(2)) : f.normal.unitOrthogonal();
   R.curvature = fu.ok ? fu.eigenvalues[0] / std::max(fu.eigenvalues.sum(), 1e-12f) : 0.f;

@@ -160,7 +160,8 @@ void Segmentation::seed_pass(int cell, std::vector<Grow>& grows) {
       }
     // Mostly on pixels a seed before already grew into a region too small to keep: clutter
     // (real frames: hundreds of such seeds, each regrowing the same pixels).
-    if (static_cast<int>(seed_pixels_.size()) < need || 2 * tried > static_cast<int>(seed_pixels_.size())) continue;
+    if (static_cast<int>(seed_pixels_.size()) < need || 2 * tried > static_cast<int>(seed_pixels_.size()))
+      continue;
     const PlaneFit f = fit_plane(m);
     if (!f.ok) continue;
     Grow g;
@@ -226,7 +227,8 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
     for (int u0 = 0; u0 + len <= W_; u0 += len) {
       // Windows inside coarse cells that joined a region have no free pixel left.
       const int cu0 = ucell_[u0], cu1 = ucell_[u0 + len - 1];
-      if (cu0 == cu1 && cu0 < CW_ && cv1 < CH_ && cell_label_[static_cast<std::size_t>(cv0 * CW_ + cu0)] >= 0 &&
+      if (cu0 == cu1 && cu0 < CW_ && cv1 < CH_ &&
+          cell_label_[static_cast<std::size_t>(cv0 * CW_ + cu0)] >= 0 &&
           cell_label_[static_cast<std::size_t>(cv1 * CW_ + cu0)] >= 0)
         continue;
       InvDepthMoments m;
@@ -249,7 +251,6 @@ void Segmentation::strip_pass(std::vector<Grow>& grows) {
     grows.push_back(g);
   }
 }
-
 
 bool Segmentation::grow_line(int region, const std::vector<int>& seed_pixels, Grow& g) {
   // grow_region's tests (plane within the noise, local continuity against the plane's slope) and
@@ -276,7 +277,8 @@ bool Segmentation::grow_line(int region, const std::vector<int>& seed_pixels, Gr
         smooth += w_[q] > 0.f && std::fabs(w_[q] - wp) <= kl;
       }
     }
-  if (g.count < cfg_.region_min_pixels || g.dir < 0 || 4 * smooth > sides) return release_growth(tail, g, dir);
+  if (g.count < cfg_.region_min_pixels || g.dir < 0 || 4 * smooth > sides)
+    return release_growth(tail, g, dir);
   return false;
 }
 
@@ -347,9 +349,12 @@ void Segmentation::find_line_seeds() {
         const __m128i lab = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&label_[row + u]));
         const __m128 w = _mm_loadu_ps(&w_[row + u]);
         const __m128 wu = _mm_loadu_ps(&w_[row + u - W_]), wd = _mm_loadu_ps(&w_[row + u + W_]);
-        const __m128 up = _mm_and_ps(_mm_cmpgt_ps(wu, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wu, w), absmask), kl4));
-        const __m128 down = _mm_and_ps(_mm_cmpgt_ps(wd, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wd, w), absmask), kl4));
-        const __m128 fr = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(lab, _mm_set1_epi32(-1))), _mm_cmpgt_ps(w, zero));
+        const __m128 up =
+            _mm_and_ps(_mm_cmpgt_ps(wu, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wu, w), absmask), kl4));
+        const __m128 down =
+            _mm_and_ps(_mm_cmpgt_ps(wd, zero), _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(wd, w), absmask), kl4));
+        const __m128 fr =
+            _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(lab, _mm_set1_epi32(-1))), _mm_cmpgt_ps(w, zero));
         if (_mm_movemask_ps(_mm_andnot_ps(_mm_or_ps(up, down), fr)) == 0) {
           u += 4;
           continue;

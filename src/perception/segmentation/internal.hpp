@@ -64,8 +64,8 @@ inline bool fixed_normal_gain(const InvDepthMoments& m, const Eigen::Vector3f& n
   if (m.n < 1.0) return false;
   const double nx = n.x(), ny = n.y(), nz = n.z();
   ssw = -(nx * m.suw + ny * m.svw + nz * m.sw);
-  const double sss = nx * nx * m.suu + ny * ny * m.svv + nz * nz * m.n + 2.0 * nx * ny * m.suv + 2.0 * nx * nz * m.su +
-                     2.0 * ny * nz * m.sv;
+  const double sss = nx * nx * m.suu + ny * ny * m.svv + nz * nz * m.n + 2.0 * nx * ny * m.suv +
+                     2.0 * nx * nz * m.su + 2.0 * ny * nz * m.sv;
   if (!(sss > 1e-30)) return false;
   g = ssw / sss;
   return g > 1e-9;

@@ -280,7 +280,8 @@ void Segmentation::seam_contacts(const std::vector<Grow>& grows) {
     if (la == lb || la < 0 || lb < 0) continue;
     const int a = cid[la], b = cid[lb];
     if (a < 0 || b < 0 || !(cand[a] | cand[b])) continue;
-    const std::size_t k = static_cast<std::size_t>(std::min(a, b)) * n + static_cast<std::size_t>(std::max(a, b));
+    const std::size_t k =
+        static_cast<std::size_t>(std::min(a, b)) * n + static_cast<std::size_t>(std::max(a, b));
     if (contact_[k] == 0xFFFF) continue;
     ++contact_[k];
     // Both planes pass through the seam: no depth jump between the two regions there.
@@ -369,7 +370,9 @@ void Segmentation::find_border_pixels() {
           const __m128i neg = _mm_set1_epi32(-1);
           auto ld = [&](int q) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(L + q)); };
           const __m128i a = ld(p);
-          auto other = [&](__m128i x) { return _mm_andnot_si128(_mm_cmpeq_epi32(x, a), _mm_cmpgt_epi32(x, neg)); };
+          auto other = [&](__m128i x) {
+            return _mm_andnot_si128(_mm_cmpeq_epi32(x, a), _mm_cmpgt_epi32(x, neg));
+          };
           const __m128i any = _mm_or_si128(_mm_or_si128(other(ld(p + 1)), other(ld(p - 1))),
                                            _mm_or_si128(other(ld(p + W_)), other(ld(p - W_))));
           const int mask = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(any, _mm_cmpgt_epi32(a, neg))));

@@ -38,14 +38,16 @@ PlaneFit fit_plane(const InvDepthMoments& m) {
   if (!solve_centred_plane(m, p)) return f;
   f.ok = true;
   f.d = static_cast<float>(1.0 / p.g);
-  f.normal = Eigen::Vector3f(static_cast<float>(-p.a / p.g), static_cast<float>(-p.b / p.g), static_cast<float>(-p.c / p.g));
+  f.normal = Eigen::Vector3f(static_cast<float>(-p.a / p.g), static_cast<float>(-p.b / p.g),
+                             static_cast<float>(-p.c / p.g));
   f.a = static_cast<float>(p.a);
   f.b = static_cast<float>(p.b);
   f.c = static_cast<float>(p.c);
   f.rms_w = static_cast<float>(p.rms_w);
   // The plane's point on the ray of the mean pixel stands in for the centroid.
   if (p.wm > 1e-9)
-    f.mean = Eigen::Vector3f(static_cast<float>(p.mu / p.wm), static_cast<float>(p.mv / p.wm), static_cast<float>(1.0 / p.wm));
+    f.mean = Eigen::Vector3f(static_cast<float>(p.mu / p.wm), static_cast<float>(p.mv / p.wm),
+                             static_cast<float>(1.0 / p.wm));
   return f;
 }
 
@@ -63,7 +65,9 @@ PlaneFit fit_plane_fixed_normal(const InvDepthMoments& m, const Eigen::Vector3f&
   f.rms_w = static_cast<float>(std::sqrt(std::max(0.0, (m.sww - g * ssw) / m.n)));
   const double in = 1.0 / m.n, mu = m.su * in, mv = m.sv * in;
   const double wm = f.a * mu + f.b * mv + f.c;
-  if (wm > 1e-9) f.mean = Eigen::Vector3f(static_cast<float>(mu / wm), static_cast<float>(mv / wm), static_cast<float>(1.0 / wm));
+  if (wm > 1e-9)
+    f.mean = Eigen::Vector3f(static_cast<float>(mu / wm), static_cast<float>(mv / wm),
+                             static_cast<float>(1.0 / wm));
   return f;
 }
 
@@ -71,7 +75,8 @@ void Segmentation::find_dominant_directions(const std::vector<Grow>& grows) {
   // Normals of the big regions of the cell pass, biggest first; one per direction (a tread and
   // the floor give one). Their fits span hundreds of rows, so their tilt is the precise one.
   dirs_.clear();
-  const double min_px = std::max<double>(cfg_.region_min_pixels, cfg_.dominant_min_fraction * stats_.valid_pixels);
+  const double min_px =
+      std::max<double>(cfg_.region_min_pixels, cfg_.dominant_min_fraction * stats_.valid_pixels);
   std::vector<int>& idx = sorted_;
   idx.clear();
   for (int r = 0; r < static_cast<int>(grows.size()); ++r)

@@ -10,8 +10,16 @@ namespace {
 /// Moments of the points in `a` that are not in `b` (b a subset of a).
 InvDepthMoments moments_minus(const InvDepthMoments& a, const InvDepthMoments& b) {
   InvDepthMoments m = a;
-  m.n -= b.n; m.su -= b.su; m.sv -= b.sv; m.sw -= b.sw; m.suu -= b.suu; m.suv -= b.suv; m.svv -= b.svv;
-  m.suw -= b.suw; m.svw -= b.svw; m.sww -= b.sww;
+  m.n -= b.n;
+  m.su -= b.su;
+  m.sv -= b.sv;
+  m.sw -= b.sw;
+  m.suu -= b.suu;
+  m.suv -= b.suv;
+  m.svv -= b.svv;
+  m.suw -= b.suw;
+  m.svw -= b.svw;
+  m.sww -= b.sww;
   return m;
 }
 /// Sum of squared inverse-depth residuals of a fit (rms_w is per point).
@@ -24,7 +32,8 @@ constexpr double kSplitGain = 60;
 constexpr int kBorderBandRows = 6;  // slivers of up to this many rows at the top of the view
 }  // namespace
 
-bool Segmentation::move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels, int dir) {
+bool Segmentation::move_to_new_region(std::vector<Grow>& grows, int r, const std::vector<int>& pixels,
+                                      int dir) {
   Grow ng;
   for (int p : pixels) {
     const int v = row_of(p), u = p - v * W_;
@@ -103,7 +112,8 @@ void Segmentation::find_crease_candidates(const std::vector<Grow>& grows) {
         // The crease must run along the strip (within 30 degrees of the image rows): one across
         // it (a wall corner) does not make a strip a few rows tall.
         const Eigen::Vector3f& P = g.plane.mean;
-        const float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx, dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
+        const float du = (t.x() * P.z() - P.x() * t.z()) * K_.fx,
+                    dv = (t.y() * P.z() - P.y() * t.z()) * K_.fy;
         if (std::fabs(dv) > 0.5f * std::sqrt(du * du + dv * dv)) continue;
         // The strip's normal must lie between the two (a blend of both), not beyond either.
         const float ci = nr.dot(dirs_[i]), cj = nr.dot(dirs_[j]);
@@ -117,10 +127,13 @@ void Segmentation::find_crease_candidates(const std::vector<Grow>& grows) {
       }
     if (c.np == 0) continue;
     // Uniform spread over an extent e has variance e^2 / 12: the box is 1.5 times that, plus a cell.
-    const double hv = 1.5 * std::sqrt(3.0 * std::max(0.0, sv2)), hu = 1.5 * std::sqrt(3.0 * std::max(0.0, su2));
+    const double hv = 1.5 * std::sqrt(3.0 * std::max(0.0, sv2)),
+                 hu = 1.5 * std::sqrt(3.0 * std::max(0.0, su2));
     const double vc = mv * K_.fy + K_.cy, uc = mu * K_.fx + K_.cx;
-    c.v0 = std::max(0, static_cast<int>(vc - hv) - cs), c.v1 = std::min(H_ - 1, static_cast<int>(vc + hv) + cs);
-    c.u0 = std::max(0, static_cast<int>(uc - hu) - cs), c.u1 = std::min(W_ - 1, static_cast<int>(uc + hu) + cs);
+    c.v0 = std::max(0, static_cast<int>(vc - hv) - cs),
+    c.v1 = std::min(H_ - 1, static_cast<int>(vc + hv) + cs);
+    c.u0 = std::max(0, static_cast<int>(uc - hu) - cs),
+    c.u1 = std::min(W_ - 1, static_cast<int>(uc + hu) + cs);
     cands.push_back(c);
   }
 }
@@ -179,7 +192,8 @@ void Segmentation::split_crease(std::vector<Grow>& grows, const SplitCand& cd) {
         const PlaneFit fb = fit_plane_fixed_normal(B, dirs_[cd.pairs[pi][1 - o]]);
         if (!fb.ok || fb.rms_w > limit) continue;
         const double ssr = fit_ssr(fa, A) + fit_ssr(fb, B);
-        if (ssr < best) best = ssr, best_pair = pi, best_k = k, best_o = o, best_eu = eu, best_ev = ev, best_smin = smin;
+        if (ssr < best)
+          best = ssr, best_pair = pi, best_k = k, best_o = o, best_eu = eu, best_ev = ev, best_smin = smin;
       }
     }
   }
@@ -261,7 +275,8 @@ Segmentation::BandSplit Segmentation::best_band_split(const Grow& g, const InvDe
   // The direction a tread sliver may take against its riser's plane: square to it within 15
   // degrees below an edge (the edges found there are many, keep to treads); at the border any
   // crease of 60 degrees or more (oblique directions of clutter do not count).
-  const float max_cos = below_edge ? std::sin(15.f * 3.14159265f / 180.f) : std::cos(60.f * 3.14159265f / 180.f);
+  const float max_cos =
+      below_edge ? std::sin(15.f * 3.14159265f / 180.f) : std::cos(60.f * 3.14159265f / 180.f);
   const float limit = 0.5f * tolerance_w();
   const double sig2 = double(cfg_.depth_noise_coeff) * cfg_.depth_noise_coeff;
   const int nd = static_cast<int>(dirs_.size());
@@ -432,7 +447,8 @@ void Segmentation::split_edge_bands(std::vector<Grow>& grows) {
     if (slot[l] < 0) continue;
     const int v = row_of(p), u = p - v * W_;
     InvDepthMoments* b = &bins_[static_cast<std::size_t>(slot[l]) * K];
-    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k) b[k].add(un_[u], vn_[v + k], w_[p + k * W_]);
+    for (int k = 0; k < K && v + k < H_ && label_[p + k * W_] == l; ++k)
+      b[k].add(un_[u], vn_[v + k], w_[p + k * W_]);
   }
   for (std::size_t i = 0; i < regs.size(); ++i) {
     const int r = regs[i];
@@ -465,7 +481,8 @@ bool Segmentation::edge_band_candidates(const std::vector<Grow>& grows) {
   regs.clear();
   for (int r = 0; r < n; ++r) {
     const Grow& g = grows[r];
-    if (g.count < cfg_.region_min_pixels + static_cast<int>(kSplitMinSide) || !g.plane.ok || g.plane.rms_w > limit)
+    if (g.count < cfg_.region_min_pixels + static_cast<int>(kSplitMinSide) || !g.plane.ok ||
+        g.plane.rms_w > limit)
       continue;
     bool on_dir = false, square = false;
     for (const Eigen::Vector3f& d : dirs_) {
@@ -499,7 +516,9 @@ void Segmentation::find_edge_tops(const std::vector<Grow>& grows) {
   // and the camera's roll): its tops come in runs along a row. A top with no top of its region
   // beside it is on a side edge of the region (a riser's end, stepped holes down a slanted
   // border), whose pixels lie on the region's own plane and would spoil the band's fit.
-  auto is_top = [&](int q, int l) { return label_[q] == l && !(z_[q - W_] > 0.f) && !(z_[q - 2 * W_] > 0.f); };
+  auto is_top = [&](int q, int l) {
+    return label_[q] == l && !(z_[q - W_] > 0.f) && !(z_[q - 2 * W_] > 0.f);
+  };
   auto edge_top = [&](int p) {
     const int l = label_[p];
     if (l < 0 || slot[l] < 0) return;
@@ -517,11 +536,13 @@ void Segmentation::find_edge_tops(const std::vector<Grow>& grows) {
     for (int cu = 0; cu < CW_; ++cu) {
       const int c = cv * CW_ + cu;
       const int nv = cell_valid_[static_cast<std::size_t>(c)];
-      if (nv < cs || (nv > holey && (cv == 0 || cell_valid_[static_cast<std::size_t>(c - CW_)] > holey))) continue;
+      if (nv < cs || (nv > holey && (cv == 0 || cell_valid_[static_cast<std::size_t>(c - CW_)] > holey)))
+        continue;
       const int u0 = cu * cs;
       // A top two rows or more down the cell has two of the cell's own pixels without a reading
       // above it; one in the first two rows has holes in the bottom rows of the cell above.
-      const int v_first = cv > 0 && cell_valid_[static_cast<std::size_t>(c - CW_)] == cs * cs ? cv * cs + 2 : cv * cs;
+      const int v_first =
+          cv > 0 && cell_valid_[static_cast<std::size_t>(c - CW_)] == cs * cs ? cv * cs + 2 : cv * cs;
       const int v_end = nv >= cs * cs - 1 ? cv * cs + 2 : (cv + 1) * cs;
       for (int v = std::max(2, v_first); v < v_end; ++v) {
         const int row = v * W_;
@@ -534,7 +555,8 @@ void Segmentation::find_edge_tops(const std::vector<Grow>& grows) {
         for (; i + 4 <= cs; i += 4) {
           const float* z0 = &z_[static_cast<std::size_t>(row + u0 + i)];
           const __m128 top = _mm_cmpgt_ps(_mm_loadu_ps(z0), zero);
-          const __m128 above = _mm_or_ps(_mm_cmpgt_ps(_mm_loadu_ps(z0 - W_), zero), _mm_cmpgt_ps(_mm_loadu_ps(z0 - 2 * W_), zero));
+          const __m128 above = _mm_or_ps(_mm_cmpgt_ps(_mm_loadu_ps(z0 - W_), zero),
+                                         _mm_cmpgt_ps(_mm_loadu_ps(z0 - 2 * W_), zero));
           int mask = _mm_movemask_ps(_mm_andnot_ps(above, top));
           while (mask) {
             const int j = __builtin_ctz(static_cast<unsigned>(mask));
