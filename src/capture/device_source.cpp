@@ -40,6 +40,10 @@ std::string list_modes(const openni::SensorInfo* info) {
   return s.empty() ? "none" : s;
 }
 
+}  // namespace
+
+// Not in the anonymous namespace: DeviceSource::Impl (declared in the public header) holds one.
+namespace device_detail {
 // OpenNI2's device-disconnected event (a USB unplug) for one URI: read() reports the camera gone
 // at once instead of after read_timeout without frames. Raised on the driver's thread.
 struct UnplugListener : openni::OpenNI::DeviceDisconnectedListener {
@@ -49,8 +53,7 @@ struct UnplugListener : openni::OpenNI::DeviceDisconnectedListener {
     if (info && uri == info->getUri()) gone = true;
   }
 };
-
-}  // namespace
+}  // namespace device_detail
 
 struct DeviceSource::Impl {
   CaptureConfig config;
@@ -64,7 +67,7 @@ struct DeviceSource::Impl {
   long without_color = 0;
   std::uint64_t next = 0;
   CameraIntrinsics k;
-  UnplugListener unplug;
+  device_detail::UnplugListener unplug;
   bool listening = false;
 
   ~Impl() {

@@ -8,12 +8,13 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "manhattan/internal.hpp"
 #include "stairguide/perception/manhattan_frame.hpp"
 
 namespace stairguide {
 
 namespace {
-constexpr float kPi = 3.14159265358979f;
+using manhattan_detail::kPi;
 constexpr float kQuarter = 0.5f * kPi;  // the period of a Manhattan direction
 constexpr int kBins = 360;              // 0.25 degree bins over 90 degrees
 }  // namespace

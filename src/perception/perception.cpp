@@ -1,5 +1,7 @@
 #include "stairguide/perception/perception.hpp"
 
+#include "manhattan/internal.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -156,7 +158,7 @@ void Perception::process(const RgbdFrame& frame, SceneResult& out) {
 }
 
 namespace {
-float wrap_quarter(float a) { return manhattan_wrap(a); }
+using manhattan_detail::wrap_quarter;
 }  // namespace
 
 ManhattanSighting Perception::manhattan_sighting(const SceneResult& out, double timestamp) const {
