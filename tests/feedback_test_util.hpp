@@ -2,7 +2,9 @@
 // Helpers of the feedback tests: an ALSA configuration whose PCMs write what is played to raw
 // files (`type file` over `type null`), and finding the cues in the captured samples by normalised
 // cross-correlation with the WAVs.
+#include <gtest/gtest.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -20,6 +22,23 @@ namespace sgtest {
 namespace fs = std::filesystem;
 
 inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
+
+/// A folder of this test process's own, `NAME.PID` in the build tree (ctest runs each case in a
+/// process of its own, two at once), removed when the process ends with every case passed and
+/// kept for a look when one failed. Meant for a namespace-scope constant of the test file.
+inline fs::path process_dir(const std::string& name) {
+  struct RemoveWhenPassed : ::testing::Environment {
+    explicit RemoveWhenPassed(fs::path d) : dir(std::move(d)) {}
+    void TearDown() override {
+      std::error_code ec;
+      if (!::testing::UnitTest::GetInstance()->Failed()) fs::remove_all(dir, ec);
+    }
+    fs::path dir;
+  };
+  const fs::path dir = fs::path(STAIRGUIDE_BINARY_DIR) / (name + "." + std::to_string(getpid()));
+  ::testing::AddGlobalTestEnvironment(new RemoveWhenPassed(dir));
+  return dir;
+}
 
 /// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 raw, interleaved
 /// as many channels as the sink opened it with). The names in `mono_only` are PCMs that refuse

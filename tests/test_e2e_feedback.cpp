@@ -119,7 +119,7 @@ TEST(E2eFeedback, ApproachAndClimbSaysStairsAheadGoingUpFirst) {
   EXPECT_EQ(names[0], "stairs_up") << ::testing::PrintToString(names);
   // Felt: the ready pulse, then the rising pair (short-long) of stairs going up. Within 15 ms here:
   // the buzzer thread shares two cores with the whole pipeline (and the other tests); its own
-  // timing, 5 ms, is test_feedback_haptic's.
+  // timing, 5 ms, is test_runtime_devices_haptic's.
   ASSERT_GE(r.edges.size(), 6u);
   EXPECT_NEAR(r.edges[1].first - r.edges[0].first, 150.0, 15.0);
   EXPECT_NEAR(r.edges[3].first - r.edges[2].first, 80.0, 15.0);

@@ -15,6 +15,9 @@
 #include "stairguide/feedback/cue_policy.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/power_supply.hpp"
+#include "stairguide/runtime/devices/alsa_audio_sink.hpp"
+#include "stairguide/runtime/devices/button_reader.hpp"
+#include "stairguide/runtime/devices/haptic_player.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 
@@ -51,7 +54,7 @@ struct FeedbackStage::Impl {
 
   std::unique_ptr<fb::AudioSink> audio;
   // `audio` when it is the ALSA sink (its counters); read by cue_latency() from any thread.
-  std::atomic<fb::AlsaAudioSink*> alsa{nullptr};
+  std::atomic<devices::AlsaAudioSink*> alsa{nullptr};
   // Cues lost to a sound outage (issue 41: they left no trace): dropped unplayed because they
   // waited past their age or overflowed the queue, not made stale on purpose by a newer step.
   std::uint64_t lost_seen = 0;
@@ -63,7 +66,7 @@ struct FeedbackStage::Impl {
   SteadyClock::time_point next_battery_poll{};  // the first frame reads it
   bool battery_seen = false;
   // The wearer's button: read on a thread of its own, opened on the first poll or frame.
-  std::unique_ptr<fb::ButtonReader> button;
+  std::unique_ptr<devices::ButtonReader> button;
   bool button_tried = false;
   SteadyClock::time_point last_decide = SteadyClock::now();  // the frames' clock is carried on from it
 
@@ -77,8 +80,8 @@ struct FeedbackStage::Impl {
     auto warn = [](const std::string& s) { spdlog::warn("{}", s); };
     try {
       fb::PressTiming tm{f.button_debounce, f.button_long_press, f.button_double_press};
-      button = std::make_unique<fb::ButtonReader>(
-          fb::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
+      button = std::make_unique<devices::ButtonReader>(
+          devices::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
       spdlog::info(
           "button: reading presses on {} (short: where are the stairs; long: mute {:.0f} s; double: "
           "verbosity)",
@@ -132,15 +135,15 @@ struct FeedbackStage::Impl {
         for (const auto& p : bank.problems) spdlog::error("audio: sound {}: that cue is silent", p);
     }
     if (f.audio_enabled && !bank.clips.empty()) {
-      fb::AlsaSinkOptions o;
+      devices::AlsaSinkOptions o;
       o.device = f.audio_device;
       o.retry_s = f.audio_retry;
       o.stereo = f.stereo_pan;
-      fb::AudioEvents ev;
+      devices::AudioEvents ev;
       ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
       ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) { started(id, t); };
-      auto sink = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
+      auto sink = std::make_unique<devices::AlsaAudioSink>(o, std::move(bank), std::move(ev));
       alsa = sink.get();
       audio = std::move(sink);
     } else {
@@ -149,14 +152,15 @@ struct FeedbackStage::Impl {
     haptic = std::make_unique<fb::NullHaptic>();
     if (f.haptic_enabled) {
       try {
-        auto player = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
+        auto player =
+            std::make_unique<devices::HapticPlayer>(devices::make_haptic_line(f.gpio_chip, f.gpio_line));
         if (player->realtime()) {
           spdlog::info("haptic: buzzer on {}, timed at real-time priority", player->describe());
         } else {
           spdlog::warn(
               "haptic: buzzer on {}, but its timing thread was refused real-time priority "
               "(needs root or LimitRTPRIO>={}); pulses may come a few ms late on a busy machine",
-              player->describe(), fb::HapticPlayer::kRealtimePriority);
+              player->describe(), devices::HapticPlayer::kRealtimePriority);
         }
         haptic = std::move(player);
       } catch (const std::exception& e) {
@@ -168,7 +172,7 @@ struct FeedbackStage::Impl {
 
   /// Cues the sound device dropped unplayed so far (0 without the ALSA sink).
   std::uint64_t lost() const {
-    const fb::AlsaAudioSink* sink = alsa.load();
+    const devices::AlsaAudioSink* sink = alsa.load();
     if (!sink) return 0;
     const auto c = sink->counters();
     return c.stale > c.superseded ? c.stale - c.superseded : 0;

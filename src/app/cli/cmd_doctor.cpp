@@ -42,6 +42,9 @@
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/sound_bank.hpp"
+#include "stairguide/runtime/devices/alsa_audio_sink.hpp"
+#include "stairguide/runtime/devices/button_reader.hpp"
+#include "stairguide/runtime/devices/haptic_player.hpp"
 
 namespace stairguide::cli {
 namespace {
@@ -205,16 +208,16 @@ Check check_sound(const FeedbackConfig& cfg) {
   bank.clips["doctor_tone"] = tone;
   std::mutex m;
   std::string warning;
-  feedback::AudioEvents ev;
+  runtime::devices::AudioEvents ev;
   ev.warn = [&](const std::string& w) {
     std::lock_guard<std::mutex> lk(m);
     if (warning.empty()) warning = w;
   };
-  feedback::AlsaSinkOptions opt;
+  runtime::devices::AlsaSinkOptions opt;
   opt.device = cfg.audio_device;
   opt.retry_s = 60.0;  // one attempt
   opt.max_age_s = 2.0;
-  feedback::AlsaAudioSink sink(opt, bank, ev);
+  runtime::devices::AlsaAudioSink sink(opt, bank, ev);
   feedback::Utterance u;
   u.id = 1;
   u.clips = {"doctor_tone"};
@@ -222,7 +225,7 @@ Check check_sound(const FeedbackConfig& cfg) {
   u.queued = feedback::SteadyClock::now();
   sink.play(u);
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(3);
-  feedback::AlsaAudioSink::Counters k;
+  runtime::devices::AlsaAudioSink::Counters k;
   for (;;) {
     k = sink.counters();
     if (k.played > 0 || k.open_failures > 0 || std::chrono::steady_clock::now() > until) break;
@@ -263,7 +266,7 @@ Check check_buzzer(const FeedbackConfig& cfg) {
       file ? "the buzzer's edge file " + cfg.gpio_chip.substr(5) + " (a test buzzer)"
            : "GPIO line " + std::to_string(cfg.gpio_line) + " of '" + cfg.gpio_chip + "'";
   try {
-    auto line = feedback::make_haptic_line(cfg.gpio_chip, cfg.gpio_line);
+    auto line = runtime::devices::make_haptic_line(cfg.gpio_chip, cfg.gpio_line);
     line->set(true);  // one 150 ms pulse: the helper can feel that this is the right line
     std::this_thread::sleep_for(std::chrono::milliseconds(150));
     line->set(false);
@@ -292,7 +295,7 @@ Check check_button(const FeedbackConfig& cfg) {
            : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
   try {
     const auto line =
-        feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
+        runtime::devices::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
     c.message =
         where + (file ? " opened" : " requested for its edges") +
         ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
