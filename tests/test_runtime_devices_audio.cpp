@@ -42,6 +42,37 @@ SoundBank bank(float volume = 0.8f) {
   return load_sound_bank(sgtest::sounds_dir(), all_clip_names(), volume);
 }
 
+/// What a sink reports from its thread, in order: its warnings, its info lines and the utterances
+/// started. Declared before the sink (it outlives the sink's thread).
+class SinkLog {
+ public:
+  AudioEvents events() {
+    AudioEvents ev;
+    ev.warn = [this](const std::string& s) { add(warn_, s); };
+    ev.info = [this](const std::string& s) { add(info_, s); };
+    ev.on_start = [this](std::uint64_t id, SteadyClock::time_point) { add(started_, id); };
+    return ev;
+  }
+  std::vector<std::string> warnings() const { return get(warn_); }
+  std::vector<std::string> info() const { return get(info_); }
+  std::vector<std::uint64_t> started() const { return get(started_); }
+
+ private:
+  template <class T>
+  void add(std::vector<T>& v, T x) {
+    std::lock_guard<std::mutex> lk(m_);
+    v.push_back(std::move(x));
+  }
+  template <class T>
+  std::vector<T> get(const std::vector<T>& v) const {
+    std::lock_guard<std::mutex> lk(m_);
+    return v;
+  }
+  mutable std::mutex m_;
+  std::vector<std::string> warn_, info_;
+  std::vector<std::uint64_t> started_;
+};
+
 Utterance utt(std::uint64_t id, int priority, std::vector<std::string> clips) {
   Utterance u;
   u.id = id;
@@ -54,19 +85,13 @@ Utterance utt(std::uint64_t id, int priority, std::vector<std::string> clips) {
 
 TEST(FeedbackAlsa, CuesHeardInOrderThroughAFilePcm) {
   alsa_setup();
-  std::vector<std::uint64_t> started;
-  std::mutex m;
+  SinkLog log;
   {
-    AudioEvents ev;
-    ev.on_start = [&](std::uint64_t id, SteadyClock::time_point) {
-      std::lock_guard<std::mutex> lk(m);
-      started.push_back(id);
-    };
     AlsaSinkOptions o;
     o.device = "sg_order";
     o.stereo = false;    // the very samples of the WAVs
     o.max_age_s = 10.0;  // the three wait behind each other longer than the default 3 s
-    AlsaAudioSink sink(o, bank(), ev);
+    AlsaAudioSink sink(o, bank(), log.events());
     const auto t0 = SteadyClock::now();
     sink.play(utt(1, 4, {"stairs_up", "n3", "metres"}));
     sink.play(utt(2, 1, {"tick"}));
@@ -87,7 +112,7 @@ TEST(FeedbackAlsa, CuesHeardInOrderThroughAFilePcm) {
     EXPECT_EQ(c.played, 3u);
     EXPECT_EQ(c.cut, 0u);
   }
-  EXPECT_EQ(started, (std::vector<std::uint64_t>{1, 3, 2}));
+  EXPECT_EQ(log.started(), (std::vector<std::uint64_t>{1, 3, 2}));
   const auto cap = sgtest::read_raw(kDir / "sg_order.raw");
   const auto h =
       sgtest::heard(cap, {"stairs_up", "stairs_down", "n3", "metres", "tick", "last_step", "first_step"});
@@ -135,18 +160,12 @@ TEST(FeedbackAlsa, HigherPriorityCutsWhatIsPlaying) {
 
 TEST(FeedbackAlsa, DeviceThatCannotBeOpenedIsNamedAndRetried) {
   alsa_setup();
-  std::vector<std::string> warnings;
-  std::mutex m;
-  AudioEvents ev;
-  ev.warn = [&](const std::string& s) {
-    std::lock_guard<std::mutex> lk(m);
-    warnings.push_back(s);
-  };
+  SinkLog log;
   AlsaSinkOptions o;
   o.device = "sg_no_such_pcm";
   o.retry_s = 0.3;
   o.max_age_s = 1.0;
-  AlsaAudioSink sink(o, bank(), ev);
+  AlsaAudioSink sink(o, bank(), log.events());
   const auto t0 = SteadyClock::now();
   for (int i = 0; i < 5; ++i) sink.play(utt(static_cast<std::uint64_t>(i), 4, {"ready"}));
   const double play_ms = std::chrono::duration<double, std::milli>(SteadyClock::now() - t0).count();
@@ -157,20 +176,14 @@ TEST(FeedbackAlsa, DeviceThatCannotBeOpenedIsNamedAndRetried) {
   EXPECT_LE(c.open_failures, 6u);
   EXPECT_EQ(c.stale, 5u);  // dropped once stale, never played late
   EXPECT_FALSE(c.device_open);
-  std::lock_guard<std::mutex> lk(m);
+  const auto warnings = log.warnings();
   ASSERT_EQ(warnings.size(), 1u);  // said once, not on every retry
   EXPECT_NE(warnings[0].find("cannot open ALSA device 'sg_no_such_pcm'"), std::string::npos) << warnings[0];
 }
 
 TEST(FeedbackAlsa, DeviceThatAppearsLaterIsOpenedAtTheNextRetry) {
   alsa_setup();
-  std::vector<std::string> info;
-  std::mutex m;
-  AudioEvents ev;
-  ev.info = [&](const std::string& s) {
-    std::lock_guard<std::mutex> lk(m);
-    info.push_back(s);
-  };
+  SinkLog log;
   AlsaSinkOptions o;
   o.device = "sg_late";
   o.stereo = false;
@@ -178,7 +191,7 @@ TEST(FeedbackAlsa, DeviceThatAppearsLaterIsOpenedAtTheNextRetry) {
   o.max_age_s = 10.0;
   fs::remove(kDir / "sg_late.raw");
   {
-    AlsaAudioSink sink(o, bank(), ev);
+    AlsaAudioSink sink(o, bank(), log.events());
     sink.play(utt(1, 4, {"camera_back"}));
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
     EXPECT_GE(sink.counters().open_failures, 1u);
@@ -192,11 +205,9 @@ TEST(FeedbackAlsa, DeviceThatAppearsLaterIsOpenedAtTheNextRetry) {
     ASSERT_TRUE(sink.drain(std::chrono::seconds(5)));
     EXPECT_TRUE(sink.counters().device_open);
     EXPECT_EQ(sink.counters().played, 1u);
-    {
-      std::lock_guard<std::mutex> lk(m);
-      ASSERT_EQ(info.size(), 1u);
-      EXPECT_NE(info[0].find("'sg_late' open"), std::string::npos) << info[0];
-    }
+    const auto info = log.info();
+    ASSERT_EQ(info.size(), 1u);
+    EXPECT_NE(info[0].find("'sg_late' open"), std::string::npos) << info[0];
   }  // closed: the file PCM has written everything
   const auto h = sgtest::heard(sgtest::read_raw(kDir / "sg_late.raw"), {"camera_back", "camera_lost"});
   EXPECT_EQ(sgtest::names_of(h), (std::vector<std::string>{"camera_back"}));
@@ -223,32 +234,22 @@ TEST(FeedbackAlsa, EarconIsMixedOverAPhraseAtOnce) {
   std::vector<std::string> words;
   for (int i = 1; i <= 10; ++i) words.push_back("n" + std::to_string(i));
   const auto phrase = concat(words), tick = sgtest::clip("tick");
-  std::vector<std::uint64_t> started;
-  std::mutex m;
+  SinkLog log;
   {
     AlsaSinkOptions o;
     o.device = "sg_mix";
     o.stereo = false;
-    AudioEvents ev;
-    ev.on_start = [&](std::uint64_t id, SteadyClock::time_point) {
-      std::lock_guard<std::mutex> lk(m);
-      started.push_back(id);
-    };
-    AlsaAudioSink sink(o, bank(1.0f), ev);
+    AlsaAudioSink sink(o, bank(1.0f), log.events());
     sink.play(utt(1, 4, words));
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
     Utterance t = utt(2, 1, {"tick"});
     t.delivery = Delivery::kMix;
     sink.play(t);
-    {
-      std::lock_guard<std::mutex> lk(m);
-      // The tick is not waiting: started already, or within a chunk or two.
-    }
     ASSERT_TRUE(sink.drain(std::chrono::seconds(10)));
     EXPECT_EQ(sink.counters().played, 2u);
     EXPECT_EQ(sink.counters().cut, 0u);
   }
-  EXPECT_EQ(started, (std::vector<std::uint64_t>{1, 2}));
+  EXPECT_EQ(log.started(), (std::vector<std::uint64_t>{1, 2}));
   const auto cap = sgtest::read_raw(kDir / "sg_mix.raw");
   ASSERT_GE(cap.size(), phrase.size());
   long at = -1;
@@ -274,8 +275,7 @@ TEST(FeedbackAlsa, EarconIsMixedOverAPhraseAtOnce) {
 // marked at once by a tick mixed over that phrase instead of waiting behind it.
 TEST(FeedbackAlsa, StepPhraseCutsTheStaleAndIsTickedOverAHigherPhrase) {
   alsa_setup();
-  std::vector<std::uint64_t> started;
-  std::mutex m;
+  SinkLog log;
   auto step_utt = [](std::uint64_t id, Cue c, std::vector<std::string> clips) {
     Utterance u = utt(id, cue_priority(c), std::move(clips));
     u.delivery = Delivery::kCut;
@@ -287,13 +287,8 @@ TEST(FeedbackAlsa, StepPhraseCutsTheStaleAndIsTickedOverAHigherPhrase) {
   AlsaSinkOptions o;
   o.device = "sg_step";
   o.stereo = false;
-  AudioEvents ev;
-  ev.on_start = [&](std::uint64_t id, SteadyClock::time_point) {
-    std::lock_guard<std::mutex> lk(m);
-    started.push_back(id);
-  };
   {
-    AlsaAudioSink sink(o, bank(1.0f), ev);
+    AlsaAudioSink sink(o, bank(1.0f), log.events());
     Utterance a = utt(1, cue_priority(Cue::kStairsAhead), {"stairs_up", "n3", "metres"});
     a.kinds = cue_bit(Cue::kStairsAhead);
     sink.play(a);
@@ -315,7 +310,7 @@ TEST(FeedbackAlsa, StepPhraseCutsTheStaleAndIsTickedOverAHigherPhrase) {
     EXPECT_EQ(c.superseded, 1u);
     EXPECT_EQ(c.fallbacks, 1u);
   }
-  EXPECT_EQ(started, (std::vector<std::uint64_t>{1, 2, 3, 5}));
+  EXPECT_EQ(log.started(), (std::vector<std::uint64_t>{1, 2, 3, 5}));
   const auto cap = sgtest::read_raw(kDir / "sg_step.raw");
   const auto h = sgtest::heard(cap, {"stairs_up", "first_step", "stairs_down", "n5", "metres"});
   EXPECT_EQ(sgtest::names_of(h), (std::vector<std::string>{"first_step"}));
@@ -383,17 +378,11 @@ TEST(FeedbackAlsa, CuesArePannedByTheStaircasesBearing) {
 // A device that refuses two channels (a mono card) is served mono: the cue is the clip itself.
 TEST(FeedbackAlsa, MonoDeviceIsServedMono) {
   alsa_setup();
-  std::vector<std::string> info;
-  std::mutex m;
-  AudioEvents ev;
-  ev.info = [&](const std::string& s) {
-    std::lock_guard<std::mutex> lk(m);
-    info.push_back(s);
-  };
+  SinkLog log;
   {
     AlsaSinkOptions o;
     o.device = "sg_monodev";
-    AlsaAudioSink sink(o, bank(1.0f), ev);
+    AlsaAudioSink sink(o, bank(1.0f), log.events());
     Utterance u = utt(1, 4, {"ready"});
     u.pan = 0.8f;  // ignored: one channel
     sink.play(u);
@@ -404,7 +393,7 @@ TEST(FeedbackAlsa, MonoDeviceIsServedMono) {
   ASSERT_EQ(sgtest::names_of(h), (std::vector<std::string>{"ready"}));
   EXPECT_EQ(h[0].pos, 0);
   EXPECT_GT(h[0].score, 0.999);
-  std::lock_guard<std::mutex> lk(m);
+  const auto info = log.info();
   ASSERT_EQ(info.size(), 1u);
   EXPECT_NE(info[0].find("refused two channels"), std::string::npos) << info[0];
 }
