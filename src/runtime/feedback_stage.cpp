@@ -357,44 +357,45 @@ void FeedbackStage::camera_back() {
   if (!c.empty()) spdlog::info("cue {}", c);
 }
 
+namespace {
+// `f(x, y, button)` on each pair of the feedback settings read when the devices are opened: the
+// sound device, the sounds, the language and the buzzer (`button` false; read with the sinks) and
+// the button's (true; read when the button is first looked at). They apply at the next start.
+template <class A, class B, class F>
+void device_settings(A& x, B& y, F f) {
+  f(x.audio_enabled, y.audio_enabled, false);
+  f(x.audio_device, y.audio_device, false);
+  f(x.sounds_dir, y.sounds_dir, false);
+  f(x.volume, y.volume, false);
+  f(x.stereo_pan, y.stereo_pan, false);
+  f(x.haptic_enabled, y.haptic_enabled, false);
+  f(x.gpio_chip, y.gpio_chip, false);
+  f(x.gpio_line, y.gpio_line, false);
+  f(x.language, y.language, false);
+  f(x.button_enabled, y.button_enabled, true);
+  f(x.button_chip, y.button_chip, true);
+  f(x.button_line, y.button_line, true);
+  f(x.button_active_low, y.button_active_low, true);
+  f(x.button_debounce, y.button_debounce, true);
+  f(x.button_long_press, y.button_long_press, true);
+  f(x.button_double_press, y.button_double_press, true);
+}
+}  // namespace
+
 void FeedbackStage::reconfigure(const PipelineConfig& config) {
   const FeedbackConfig& a = impl_->config.feedback;
   const FeedbackConfig& b = config.feedback;
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
-  if (impl_->sinks_open &&
-      (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
-       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
-       a.stereo_pan != b.stereo_pan || a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line ||
-       a.language != b.language || a.button_enabled != b.button_enabled || a.button_chip != b.button_chip ||
-       a.button_line != b.button_line || a.button_active_low != b.button_active_low ||
-       a.button_debounce != b.button_debounce || a.button_long_press != b.button_long_press ||
-       a.button_double_press != b.button_double_press))
+  bool differ = false;
+  device_settings(a, b, [&](const auto& x, const auto& y, bool) { differ = differ || x != y; });
+  if (impl_->sinks_open && differ)
     spdlog::info(
         "feedback: sound device, sounds, language, buzzer and button settings apply at the next start");
+  // The devices stay as opened; only the policy's tunables change now.
   PipelineConfig keep = config;
-  const FeedbackConfig old = impl_->config.feedback;
-  keep.feedback = b;
-  if (impl_->sinks_open) {
-    // The sinks stay as opened; only the policy's tunables change now.
-    keep.feedback.audio_enabled = old.audio_enabled;
-    keep.feedback.audio_device = old.audio_device;
-    keep.feedback.sounds_dir = old.sounds_dir;
-    keep.feedback.volume = old.volume;
-    keep.feedback.stereo_pan = old.stereo_pan;
-    keep.feedback.haptic_enabled = old.haptic_enabled;
-    keep.feedback.gpio_chip = old.gpio_chip;
-    keep.feedback.gpio_line = old.gpio_line;
-    keep.feedback.language = old.language;
-  }
-  if (impl_->button_tried) {
-    keep.feedback.button_enabled = old.button_enabled;
-    keep.feedback.button_chip = old.button_chip;
-    keep.feedback.button_line = old.button_line;
-    keep.feedback.button_active_low = old.button_active_low;
-    keep.feedback.button_debounce = old.button_debounce;
-    keep.feedback.button_long_press = old.button_long_press;
-    keep.feedback.button_double_press = old.button_double_press;
-  }
+  device_settings(keep.feedback, a, [&](auto& kept, const auto& old, bool button) {
+    if (button ? impl_->button_tried : impl_->sinks_open) kept = old;
+  });
   impl_->config = keep;
   impl_->policy.reconfigure(keep.feedback);
 }
