@@ -1,16 +1,24 @@
 #pragma once
 // Helpers of the feedback tests: an ALSA configuration whose PCMs write what is played to raw
-// files (`type file` over `type null`), and finding the cues in the captured samples by normalised
-// cross-correlation with the WAVs.
+// files (`type file` over `type null`), finding the cues in the captured samples by normalised
+// cross-correlation with the WAVs, and stairguided run end to end with its cues heard that way.
+#include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stairguide/feedback/sound_bank.hpp"
@@ -20,6 +28,23 @@ namespace sgtest {
 namespace fs = std::filesystem;
 
 inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
+
+/// A folder of this test process's own, `NAME.PID` in the build tree (ctest runs each case in a
+/// process of its own, two at once), removed when the process ends with every case passed and
+/// kept for a look when one failed. Meant for a namespace-scope constant of the test file.
+inline fs::path process_dir(const std::string& name) {
+  struct RemoveWhenPassed : ::testing::Environment {
+    explicit RemoveWhenPassed(fs::path d) : dir(std::move(d)) {}
+    void TearDown() override {
+      std::error_code ec;
+      if (!::testing::UnitTest::GetInstance()->Failed()) fs::remove_all(dir, ec);
+    }
+    fs::path dir;
+  };
+  const fs::path dir = fs::path(STAIRGUIDE_BINARY_DIR) / (name + "." + std::to_string(getpid()));
+  ::testing::AddGlobalTestEnvironment(new RemoveWhenPassed(dir));
+  return dir;
+}
 
 /// Writes `conf` with one file PCM per name (pcm.NAME writes DIR/NAME.raw, S16 raw, interleaved
 /// as many channels as the sink opened it with). The names in `mono_only` are PCMs that refuse
@@ -129,6 +154,71 @@ inline std::vector<std::string> names_of(const std::vector<Hit>& h) {
   std::vector<std::string> n;
   for (const auto& x : h) n.push_back(x.name);
   return n;
+}
+
+/// What stairguided did in a replay run by run_daemon().
+struct DaemonRun {
+  int code = -1;
+  std::vector<std::string> cues;                     ///< frame-line cue tokens, in frame order
+  std::vector<std::pair<double, std::string>> told;  ///< each cue token (split at '+') with its frame's ts
+  std::string summary;                               ///< the summary line
+  Stereo stereo;                                     ///< what was played (stereo: the default)
+  std::vector<std::int16_t> audio;                   ///< (left + right) / 2 of it
+  std::vector<std::pair<double, int>> edges;         ///< the buzzer's: ms, level
+  std::string log;                                   ///< stderr
+};
+
+/// Runs stairguided on `replay` with `extra_args`, its cues played to the ALSA file PCM `name`
+/// (DIR/NAME.raw) and its buzzer's edges written to DIR/NAME.edges; `extra_yaml` is added to the
+/// config's feedback section (indented keys).
+inline DaemonRun run_daemon(const fs::path& dir, const std::string& name, const std::string& replay,
+                            const std::string& extra_args, const std::string& extra_yaml = "") {
+  fs::create_directories(dir);
+  const fs::path conf = dir / (name + ".yaml"), alsa = dir / (name + ".asound.conf");
+  const fs::path edges = dir / (name + ".edges"), err = dir / (name + ".stderr");
+  write_alsa_config(alsa, dir, {name});
+  fs::remove(dir / (name + ".raw"));
+  {
+    std::ofstream f(conf);
+    f << "feedback:\n  audio_device: \"default\"\n  sounds_dir: \"" << sounds_dir()
+      << "\"\n  gpio_chip: \"file:" << edges.string() << "\"\n"
+      << extra_yaml;
+  }
+  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " +
+                          conf.string() + " --replay " + replay + " --audio " + name + " " + extra_args +
+                          " 2>" + err.string();
+  DaemonRun r;
+  std::FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 8192> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) {
+    const std::string line = buf.data();
+    if (line.rfind("summary ", 0) == 0) r.summary = line;
+    const auto at = line.find(" cue=");
+    if (line.rfind("frame=", 0) != 0 || at == std::string::npos) continue;
+    std::istringstream is(line.substr(at + 5));
+    std::string tok;
+    is >> tok;
+    if (tok == "-") continue;
+    r.cues.push_back(tok);
+    const auto ts = line.find(" ts=");
+    const double t = ts == std::string::npos ? -1.0 : std::atof(line.c_str() + ts + 4);
+    std::istringstream parts(tok);
+    for (std::string one; std::getline(parts, one, '+');) r.told.push_back({t, one});
+  }
+  const int st = pclose(p);
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  r.stereo = split(read_raw(dir / (name + ".raw")));
+  r.audio = r.stereo.mid();
+  std::ifstream ef(edges);
+  double t;
+  int v;
+  while (ef >> t >> v) r.edges.push_back({t, v});
+  std::ifstream lf(err);
+  std::stringstream ss;
+  ss << lf.rdbuf();
+  r.log = ss.str();
+  return r;
 }
 
 }  // namespace sgtest

@@ -18,6 +18,7 @@
 #include <map>
 #include <sstream>
 
+#include "cli_test_util.hpp"
 #include "feedback_test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -30,67 +31,11 @@ const std::vector<std::string> kStairClips = {
     "stairs_up", "stairs_down",   "step_up",    "step_down", "curb_up", "curb_down", "first_step",
     "last_step", "end_of_stairs", "steps_left", "warning",   "up",      "down",      "approach"};
 
-struct Result {
-  int code = -1;
-  std::vector<std::string> cues;                     // frame-line cue tokens, in frame order
-  std::vector<std::pair<double, std::string>> told;  // each cue token (split at '+') with its frame's ts
-  std::string summary;
-  std::vector<std::int16_t> audio;  // (left + right) / 2 of the stereo capture
-  sgtest::Stereo stereo;
-  std::vector<std::pair<double, int>> edges;
-  std::string log;
-};
+using Result = sgtest::DaemonRun;
 
 Result run_daemon(const std::string& name, const std::string& replay, const std::string& extra_args,
                   const std::string& extra_yaml = "") {
-  fs::create_directories(kDir);
-  const fs::path conf = kDir / (name + ".yaml"), alsa = kDir / (name + ".asound.conf");
-  const fs::path edges = kDir / (name + ".edges"), err = kDir / (name + ".stderr");
-  sgtest::write_alsa_config(alsa, kDir, {name});
-  fs::remove(kDir / (name + ".raw"));
-  {
-    std::ofstream f(conf);
-    f << "feedback:\n  audio_device: \"default\"\n  sounds_dir: \"" << sgtest::sounds_dir()
-      << "\"\n  gpio_chip: \"file:" << edges.string() << "\"\n"
-      << extra_yaml;
-  }
-  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " +
-                          conf.string() + " --replay " + replay + " --audio " + name + " " + extra_args +
-                          " 2>" + err.string();
-  Result r;
-  std::FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 8192> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) {
-    const std::string line = buf.data();
-    if (line.rfind("summary ", 0) == 0) r.summary = line;
-    const auto at = line.find(" cue=");
-    if (line.rfind("frame=", 0) == 0 && at != std::string::npos) {
-      std::istringstream is(line.substr(at + 5));
-      std::string tok;
-      is >> tok;
-      if (tok != "-") {
-        r.cues.push_back(tok);
-        const auto ts = line.find(" ts=");
-        const double t = ts == std::string::npos ? -1.0 : std::atof(line.c_str() + ts + 4);
-        std::istringstream parts(tok);
-        for (std::string one; std::getline(parts, one, '+');) r.told.push_back({t, one});
-      }
-    }
-  }
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.stereo = sgtest::split(sgtest::read_raw(kDir / (name + ".raw")));  // stereo: the default
-  r.audio = r.stereo.mid();
-  std::ifstream ef(edges);
-  double t;
-  int v;
-  while (ef >> t >> v) r.edges.push_back({t, v});
-  std::ifstream lf(err);
-  std::stringstream ss;
-  ss << lf.rdbuf();
-  r.log = ss.str();
-  return r;
+  return sgtest::run_daemon(kDir, name, replay, extra_args, extra_yaml);
 }
 
 bool stair_token(const std::string& t) {
@@ -119,7 +64,7 @@ TEST(E2eFeedback, ApproachAndClimbSaysStairsAheadGoingUpFirst) {
   EXPECT_EQ(names[0], "stairs_up") << ::testing::PrintToString(names);
   // Felt: the ready pulse, then the rising pair (short-long) of stairs going up. Within 15 ms here:
   // the buzzer thread shares two cores with the whole pipeline (and the other tests); its own
-  // timing, 5 ms, is test_feedback_haptic's.
+  // timing, 5 ms, is test_runtime_devices_haptic's.
   ASSERT_GE(r.edges.size(), 6u);
   EXPECT_NEAR(r.edges[1].first - r.edges[0].first, 150.0, 15.0);
   EXPECT_NEAR(r.edges[3].first - r.edges[2].first, 80.0, 15.0);
@@ -179,17 +124,11 @@ TEST(E2eFeedback, MissingSoundDeviceAndGpioChipDaemonGoesOn) {
     std::ofstream f(conf);
     f << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir() << "\"\n  gpio_chip: \"gpiochip_sg_absent\"\n";
   }
-  std::string out;
-  const std::string cmd =
-      std::string(STAIRGUIDED) + " --config " + conf.string() +
-      " --replay synth:corridor_static:10 --fast --sync --audio sg_no_such_pcm --no-frame-lines "
-      "2>&1";
-  std::FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 0) << out;
+  const auto run = cli_test::run_shell(std::string(STAIRGUIDED) + " --config " + conf.string() +
+                                       " --replay synth:corridor_static:10 --fast --sync --audio "
+                                       "sg_no_such_pcm --no-frame-lines");
+  const std::string& out = run.out;
+  EXPECT_EQ(run.code, 0) << out;
   EXPECT_NE(out.find("cannot open ALSA device 'sg_no_such_pcm'"), std::string::npos) << out;
   EXPECT_NE(out.find("GPIO chip 'gpiochip_sg_absent' line 17: cannot open the chip"), std::string::npos)
       << out;
@@ -467,15 +406,11 @@ TEST(E2eFeedback, MissingButtonChipIsNamedAndTheDaemonGoesOn) {
   std::ofstream(conf)
       << "feedback:\n  sounds_dir: \"" << sgtest::sounds_dir()
       << "\"\n  button_enabled: true\n  button_chip: \"gpiochip_sg_absent\"\n  button_line: 5\n";
-  std::string out;
-  const std::string cmd = std::string(STAIRGUIDED) + " --config " + conf.string() +
-                          " --replay synth:corridor_static:10 --fast --sync --audio null --no-haptic 2>&1";
-  std::FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 0) << out;
+  const auto run =
+      cli_test::run_shell(std::string(STAIRGUIDED) + " --config " + conf.string() +
+                          " --replay synth:corridor_static:10 --fast --sync --audio null --no-haptic");
+  const std::string& out = run.out;
+  EXPECT_EQ(run.code, 0) << out;
   EXPECT_NE(out.find("button: GPIO chip 'gpiochip_sg_absent' line 5: cannot open the chip ("),
             std::string::npos)
       << out;

@@ -23,56 +23,8 @@ namespace {
 
 const fs::path kDir = fs::path(STAIRGUIDE_BINARY_DIR) / "e2e_feedback_drops_files";
 
-struct DaemonRun {
-  int code = -1;
-  std::vector<std::pair<double, std::string>> told;  // each cue token with its frame's timestamp
-  std::vector<std::int16_t> audio;                   // (left + right) / 2
-  std::vector<std::pair<double, int>> edges;         // buzzer: ms, level
-  std::string log;
-};
-
-DaemonRun run_daemon(const std::string& name, const std::string& replay) {
-  fs::create_directories(kDir);
-  const fs::path conf = kDir / (name + ".yaml"), alsa = kDir / (name + ".asound.conf");
-  const fs::path edges = kDir / (name + ".edges"), err = kDir / (name + ".stderr");
-  sgtest::write_alsa_config(alsa, kDir, {name});
-  fs::remove(kDir / (name + ".raw"));
-  {
-    std::ofstream f(conf);
-    f << "feedback:\n  audio_device: \"default\"\n  sounds_dir: \"" << sgtest::sounds_dir()
-      << "\"\n  gpio_chip: \"file:" << edges.string() << "\"\n";
-  }
-  const std::string cmd = "ALSA_CONFIG_PATH=" + alsa.string() + " " + STAIRGUIDED + " --config " +
-                          conf.string() + " --replay " + replay + " --audio " + name + " --fast --sync 2>" +
-                          err.string();
-  DaemonRun r;
-  std::FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 8192> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) {
-    const std::string line = buf.data();
-    const auto at = line.find(" cue="), ts = line.find(" ts=");
-    if (line.rfind("frame=", 0) != 0 || at == std::string::npos) continue;
-    std::istringstream is(line.substr(at + 5));
-    std::string tok;
-    is >> tok;
-    if (tok == "-") continue;
-    const double t = ts == std::string::npos ? -1.0 : std::atof(line.c_str() + ts + 4);
-    std::istringstream parts(tok);
-    for (std::string one; std::getline(parts, one, '+');) r.told.push_back({t, one});
-  }
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.audio = sgtest::split(sgtest::read_raw(kDir / (name + ".raw"))).mid();
-  std::ifstream ef(edges);
-  double t;
-  int v;
-  while (ef >> t >> v) r.edges.push_back({t, v});
-  std::ifstream lf(err);
-  std::stringstream ss;
-  ss << lf.rdbuf();
-  r.log = ss.str();
-  return r;
+sgtest::DaemonRun run_daemon(const std::string& name, const std::string& replay) {
+  return sgtest::run_daemon(kDir, name, replay, "--fast --sync");
 }
 
 }  // namespace
@@ -80,7 +32,7 @@ DaemonRun run_daemon(const std::string& name, const std::string& replay) {
 TEST(E2eFeedbackDrops, WalkTowardsAPlatformEdgeSaysDropAheadBeforeTheEdge) {
   const std::string preset = "drop_platform_walk";
   const std::uint32_t seed = 7;
-  const DaemonRun r =
+  const sgtest::DaemonRun r =
       run_daemon("e2e_drop_walk", "synth:" + preset + ":460:" + std::to_string(seed) + ":real-v1");
   ASSERT_EQ(r.code, 0) << r.log;
   std::vector<std::pair<double, std::string>> drops;
@@ -138,7 +90,7 @@ TEST(E2eFeedbackDrops, StairFreeWalksSayNoDrop) {
   else
     std::fprintf(stderr, "note: %s absent, the kitchen walk is skipped\n", kitchen.c_str());
   for (const auto& [name, replay] : runs) {
-    const DaemonRun r = run_daemon(name, replay);
+    const sgtest::DaemonRun r = run_daemon(name, replay);
     ASSERT_EQ(r.code, 0) << name << r.log;
     for (const auto& [t, tok] : r.told) {
       EXPECT_EQ(tok.rfind("drop_ahead", 0), std::string::npos) << name << " at " << t;

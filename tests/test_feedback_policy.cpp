@@ -31,6 +31,20 @@ CueInput floor_frame(double t) {
   return in;
 }
 
+/// Floor-only frames (nothing else in view) from `t0` until `t1`, one per kDt.
+std::vector<CueInput> floor_frames(double t0, double t1) {
+  std::vector<CueInput> f;
+  for (double t = t0; t < t1; t += kDt) f.push_back(floor_frame(t));
+  return f;
+}
+
+/// The frames of `parts`, one part after the other.
+std::vector<CueInput> joined(std::initializer_list<std::vector<CueInput>> parts) {
+  std::vector<CueInput> f;
+  for (const auto& p : parts) f.insert(f.end(), p.begin(), p.end());
+  return f;
+}
+
 CueInput stair_frame(double t, StairKind kind, float distance, float bearing = 0.f) {
   CueInput in = floor_frame(t);
   in.stair.detected = true;
@@ -144,18 +158,14 @@ TEST(FeedbackPolicy, FlickerIsNeverAnnounced) {
 TEST(FeedbackPolicy, DropoutDoesNotRetractNorRepeat) {
   FeedbackConfig c;  // forget 3 s, repeat 20 s
   CuePolicy p{c};
-  std::vector<CueInput> f = approach(0.0, StairKind::kAscending, 3.6f, 1.0);
-  for (double t = 1.0; t < 2.0; t += kDt) f.push_back(floor_frame(t));  // 1 s dropout
-  for (auto& x : approach(2.0, StairKind::kAscending, 2.6f, 1.0)) f.push_back(x);
-  for (double t = 3.0; t < 8.0; t += kDt) f.push_back(floor_frame(t));             // forgotten (> 3 s)
-  for (auto& x : approach(8.0, StairKind::kAscending, 3.0f, 1.0)) f.push_back(x);  // < 20 s: not again
+  const std::vector<CueInput> f =
+      joined({approach(0.0, StairKind::kAscending, 3.6f, 1.0), floor_frames(1.0, 2.0),  // 1 s dropout
+              approach(2.0, StairKind::kAscending, 2.6f, 1.0), floor_frames(3.0, 8.0),  // forgotten (> 3 s)
+              approach(8.0, StairKind::kAscending, 3.0f, 1.0)});                        // < 20 s: not again
   auto s = feed(p, f);
   EXPECT_EQ(count_of(s, Cue::kStairsAhead), 1) << ::testing::PrintToString(toks(s));
   // Long after: a staircase found again is announced again.
-  std::vector<CueInput> g;
-  for (double t = 9.0; t < 30.0; t += kDt) g.push_back(floor_frame(t));
-  for (auto& x : approach(30.0, StairKind::kAscending, 3.0f, 1.0)) g.push_back(x);
-  s = feed(p, g);
+  s = feed(p, joined({floor_frames(9.0, 30.0), approach(30.0, StairKind::kAscending, 3.0f, 1.0)}));
   ASSERT_EQ(count_of(s, Cue::kStairsAhead), 1);
   EXPECT_GE(s.back().t, 30.0);
 }
@@ -212,16 +222,12 @@ TEST(FeedbackPolicy, DescendingWithinDangerDistanceAlwaysWarnsEvenQuiet) {
 TEST(FeedbackPolicy, DropWarnedAgainOnlyAfterItWasForgotten) {
   FeedbackConfig c;  // forget 3 s, repeat 20 s
   CuePolicy p{c};
-  std::vector<CueInput> f = approach(0.0, StairKind::kDescending, 1.8f, 1.0);
-  for (double t = 1.0; t < 2.5; t += kDt) f.push_back(floor_frame(t));  // 1.5 s dropout: held
-  for (auto& x : approach(2.5, StairKind::kDescending, 1.5f, 0.5)) f.push_back(x);
-  auto s = feed(p, f);
+  auto s = feed(p, joined({approach(0.0, StairKind::kDescending, 1.8f, 1.0),
+                           floor_frames(1.0, 2.5),  // 1.5 s dropout: held
+                           approach(2.5, StairKind::kDescending, 1.5f, 0.5)}));
   EXPECT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
   // Out of mind for 4 s (forgotten), back within 2 m, 5 s after the warning: warned again.
-  std::vector<CueInput> g;
-  for (double t = 3.0; t < 7.0; t += kDt) g.push_back(floor_frame(t));
-  for (auto& x : approach(7.0, StairKind::kDescending, 1.5f, 1.0)) g.push_back(x);
-  s = feed(p, g);
+  s = feed(p, joined({floor_frames(3.0, 7.0), approach(7.0, StairKind::kDescending, 1.5f, 1.0)}));
   ASSERT_EQ(count_of(s, Cue::kDropWarning), 1) << ::testing::PrintToString(toks(s));
   for (const auto& x : s)
     if (x.e.cue == Cue::kDropWarning) {
@@ -597,9 +603,7 @@ TEST(FeedbackPolicy, ApproachBeepStopsWhenTurnedAwayOrStopped) {
 
 TEST(FeedbackPolicy, ApproachBeepSilentWithoutADescent) {
   CuePolicy p{FeedbackConfig{}};
-  std::vector<CueInput> f;
-  for (double t = 0; t < 10; t += kDt) f.push_back(floor_frame(t));
-  EXPECT_TRUE(beeps(feed(p, f)).empty());
+  EXPECT_TRUE(beeps(feed(p, floor_frames(0, 10))).empty());
   CuePolicy q{FeedbackConfig{}};
   EXPECT_TRUE(beeps(feed(q, approach(0.0, StairKind::kAscending, 3.f, 3.0))).empty());
   CuePolicy r{FeedbackConfig{}};  // a flicker of a descent (never confirmed)
@@ -932,8 +936,7 @@ TEST(FeedbackPolicy, DropFlickerSilentAndForgottenToldAgain) {
   EXPECT_EQ(count_of(feed(p, f), Cue::kDropAhead), 0);
   auto a = drop_walk(2.0, 1.5, 1.0);
   EXPECT_EQ(count_of(feed(p, a), Cue::kDropAhead), 1);
-  std::vector<CueInput> gap;
-  for (double t = 3.0; t < 3.0 + c.forget_time + 1.0; t += kDt) gap.push_back(floor_frame(t));
+  const std::vector<CueInput> gap = floor_frames(3.0, 3.0 + c.forget_time + 1.0);
   feed(p, gap);
   EXPECT_EQ(count_of(feed(p, drop_walk(gap.back().t + kDt, 1.5, 1.0)), Cue::kDropAhead), 1);
 }

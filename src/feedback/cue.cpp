@@ -184,6 +184,19 @@ std::string tokens(const std::vector<CueEvent>& events) {
 }
 
 namespace {
+// The distance ("3 metres") and, off straight ahead, the clock position ("2 o'clock") a cue carries,
+// each when it has one that can be said.
+void add_distance_and_clock(const CueEvent& e, std::vector<std::string>& c) {
+  if (sayable(e.number)) {
+    c.push_back(number_clip(e.number));
+    c.push_back(e.number == 1 ? "metre" : "metres");
+  }
+  if (e.clock >= 1 && e.clock <= 12) {
+    c.push_back(number_clip(e.clock));
+    c.push_back("oclock");
+  }
+}
+
 // The answer to "where are the stairs?": what is ahead with its distance and clock position (said
 // even at 12: the wearer asked where), the steps left on a flight, or "no stairs".
 std::vector<std::string> where_clips(const CueEvent& e) {
@@ -204,50 +217,32 @@ std::vector<std::string> where_clips(const CueEvent& e) {
       if (sayable(e.number)) return {number_clip(e.number), "steps_left"};
       return {"no_stairs"};
   }
-  if (sayable(e.number)) {
-    c.push_back(number_clip(e.number));
-    c.push_back(e.number == 1 ? "metre" : "metres");
-  }
-  if (e.clock >= 1 && e.clock <= 12) {
-    c.push_back(number_clip(e.clock));
-    c.push_back("oclock");
-  }
+  add_distance_and_clock(e, c);
   return c;
 }
 }  // namespace
 
 namespace {
-// The clip of a cue said by one clip of its own whatever it carries; nullptr for the others.
+// The clip of a cue said by one clip of its own whatever it carries (named as the cue, but for
+// "blind", which says what it means); nullptr for the others.
 const char* own_clip(Cue c) {
   switch (c) {
-    case Cue::kReady:
-      return "ready";
-    case Cue::kCameraLost:
-      return "camera_lost";
-    case Cue::kCameraBack:
-      return "camera_back";
     case Cue::kBlind:
       return "cannot_see";
+    case Cue::kReady:
+    case Cue::kCameraLost:
+    case Cue::kCameraBack:
     case Cue::kFirstStep:
-      return "first_step";
     case Cue::kTick:
-      return "tick";
     case Cue::kLastStep:
-      return "last_step";
     case Cue::kEndOfStairs:
-      return "end_of_stairs";
     case Cue::kApproach:
-      return "approach";
     case Cue::kBatteryLow:
-      return "battery_low";
     case Cue::kBatteryCritical:
-      return "battery_critical";
     case Cue::kSlow:
-      return "slow";
     case Cue::kMuted:
-      return "muted";
     case Cue::kUnmuted:
-      return "unmuted";
+      return to_string(c);
     default:
       return nullptr;
   }
@@ -258,16 +253,7 @@ std::vector<std::string> clips_for(const CueEvent& e) {
   if (const char* own = own_clip(e.cue)) return {own};
   std::vector<std::string> c;
   const bool up = e.direction > 0;
-  auto distance = [&] {
-    if (sayable(e.number)) {
-      c.push_back(number_clip(e.number));
-      c.push_back(e.number == 1 ? "metre" : "metres");
-    }
-    if (e.clock >= 1 && e.clock <= 12) {
-      c.push_back(number_clip(e.clock));
-      c.push_back("oclock");
-    }
-  };
+  auto distance = [&] { add_distance_and_clock(e, c); };
   switch (e.cue) {
     case Cue::kStairsAhead:
       if (e.earcon_only) {

@@ -15,6 +15,9 @@
 #include "stairguide/feedback/cue_policy.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/power_supply.hpp"
+#include "stairguide/runtime/devices/alsa_audio_sink.hpp"
+#include "stairguide/runtime/devices/button_reader.hpp"
+#include "stairguide/runtime/devices/haptic_player.hpp"
 #include "stairguide/runtime/latency.hpp"
 #include "stairguide/runtime/pipeline.hpp"
 
@@ -51,7 +54,7 @@ struct FeedbackStage::Impl {
 
   std::unique_ptr<fb::AudioSink> audio;
   // `audio` when it is the ALSA sink (its counters); read by cue_latency() from any thread.
-  std::atomic<fb::AlsaAudioSink*> alsa{nullptr};
+  std::atomic<devices::AlsaAudioSink*> alsa{nullptr};
   // Cues lost to a sound outage (issue 41: they left no trace): dropped unplayed because they
   // waited past their age or overflowed the queue, not made stale on purpose by a newer step.
   std::uint64_t lost_seen = 0;
@@ -63,7 +66,7 @@ struct FeedbackStage::Impl {
   SteadyClock::time_point next_battery_poll{};  // the first frame reads it
   bool battery_seen = false;
   // The wearer's button: read on a thread of its own, opened on the first poll or frame.
-  std::unique_ptr<fb::ButtonReader> button;
+  std::unique_ptr<devices::ButtonReader> button;
   bool button_tried = false;
   SteadyClock::time_point last_decide = SteadyClock::now();  // the frames' clock is carried on from it
 
@@ -77,8 +80,8 @@ struct FeedbackStage::Impl {
     auto warn = [](const std::string& s) { spdlog::warn("{}", s); };
     try {
       fb::PressTiming tm{f.button_debounce, f.button_long_press, f.button_double_press};
-      button = std::make_unique<fb::ButtonReader>(
-          fb::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
+      button = std::make_unique<devices::ButtonReader>(
+          devices::make_button_line(f.button_chip, f.button_line, f.button_active_low, warn), tm, warn);
       spdlog::info(
           "button: reading presses on {} (short: where are the stairs; long: mute {:.0f} s; double: "
           "verbosity)",
@@ -132,15 +135,15 @@ struct FeedbackStage::Impl {
         for (const auto& p : bank.problems) spdlog::error("audio: sound {}: that cue is silent", p);
     }
     if (f.audio_enabled && !bank.clips.empty()) {
-      fb::AlsaSinkOptions o;
+      devices::AlsaSinkOptions o;
       o.device = f.audio_device;
       o.retry_s = f.audio_retry;
       o.stereo = f.stereo_pan;
-      fb::AudioEvents ev;
+      devices::AudioEvents ev;
       ev.warn = [](const std::string& s) { spdlog::warn("{}", s); };
       ev.info = [](const std::string& s) { spdlog::info("{}", s); };
       ev.on_start = [this](std::uint64_t id, SteadyClock::time_point t) { started(id, t); };
-      auto sink = std::make_unique<fb::AlsaAudioSink>(o, std::move(bank), std::move(ev));
+      auto sink = std::make_unique<devices::AlsaAudioSink>(o, std::move(bank), std::move(ev));
       alsa = sink.get();
       audio = std::move(sink);
     } else {
@@ -149,14 +152,15 @@ struct FeedbackStage::Impl {
     haptic = std::make_unique<fb::NullHaptic>();
     if (f.haptic_enabled) {
       try {
-        auto player = std::make_unique<fb::HapticPlayer>(fb::make_haptic_line(f.gpio_chip, f.gpio_line));
+        auto player =
+            std::make_unique<devices::HapticPlayer>(devices::make_haptic_line(f.gpio_chip, f.gpio_line));
         if (player->realtime()) {
           spdlog::info("haptic: buzzer on {}, timed at real-time priority", player->describe());
         } else {
           spdlog::warn(
               "haptic: buzzer on {}, but its timing thread was refused real-time priority "
               "(needs root or LimitRTPRIO>={}); pulses may come a few ms late on a busy machine",
-              player->describe(), fb::HapticPlayer::kRealtimePriority);
+              player->describe(), devices::HapticPlayer::kRealtimePriority);
         }
         haptic = std::move(player);
       } catch (const std::exception& e) {
@@ -168,7 +172,7 @@ struct FeedbackStage::Impl {
 
   /// Cues the sound device dropped unplayed so far (0 without the ALSA sink).
   std::uint64_t lost() const {
-    const fb::AlsaAudioSink* sink = alsa.load();
+    const devices::AlsaAudioSink* sink = alsa.load();
     if (!sink) return 0;
     const auto c = sink->counters();
     return c.stale > c.superseded ? c.stale - c.superseded : 0;
@@ -353,44 +357,45 @@ void FeedbackStage::camera_back() {
   if (!c.empty()) spdlog::info("cue {}", c);
 }
 
+namespace {
+// `f(x, y, button)` on each pair of the feedback settings read when the devices are opened: the
+// sound device, the sounds, the language and the buzzer (`button` false; read with the sinks) and
+// the button's (true; read when the button is first looked at). They apply at the next start.
+template <class A, class B, class F>
+void device_settings(A& x, B& y, F f) {
+  f(x.audio_enabled, y.audio_enabled, false);
+  f(x.audio_device, y.audio_device, false);
+  f(x.sounds_dir, y.sounds_dir, false);
+  f(x.volume, y.volume, false);
+  f(x.stereo_pan, y.stereo_pan, false);
+  f(x.haptic_enabled, y.haptic_enabled, false);
+  f(x.gpio_chip, y.gpio_chip, false);
+  f(x.gpio_line, y.gpio_line, false);
+  f(x.language, y.language, false);
+  f(x.button_enabled, y.button_enabled, true);
+  f(x.button_chip, y.button_chip, true);
+  f(x.button_line, y.button_line, true);
+  f(x.button_active_low, y.button_active_low, true);
+  f(x.button_debounce, y.button_debounce, true);
+  f(x.button_long_press, y.button_long_press, true);
+  f(x.button_double_press, y.button_double_press, true);
+}
+}  // namespace
+
 void FeedbackStage::reconfigure(const PipelineConfig& config) {
   const FeedbackConfig& a = impl_->config.feedback;
   const FeedbackConfig& b = config.feedback;
   if (a.verbosity != b.verbosity) spdlog::info("feedback: verbosity {} -> {}", a.verbosity, b.verbosity);
-  if (impl_->sinks_open &&
-      (a.audio_device != b.audio_device || a.sounds_dir != b.sounds_dir || a.volume != b.volume ||
-       a.audio_enabled != b.audio_enabled || a.haptic_enabled != b.haptic_enabled ||
-       a.stereo_pan != b.stereo_pan || a.gpio_chip != b.gpio_chip || a.gpio_line != b.gpio_line ||
-       a.language != b.language || a.button_enabled != b.button_enabled || a.button_chip != b.button_chip ||
-       a.button_line != b.button_line || a.button_active_low != b.button_active_low ||
-       a.button_debounce != b.button_debounce || a.button_long_press != b.button_long_press ||
-       a.button_double_press != b.button_double_press))
+  bool differ = false;
+  device_settings(a, b, [&](const auto& x, const auto& y, bool) { differ = differ || x != y; });
+  if (impl_->sinks_open && differ)
     spdlog::info(
         "feedback: sound device, sounds, language, buzzer and button settings apply at the next start");
+  // The devices stay as opened; only the policy's tunables change now.
   PipelineConfig keep = config;
-  const FeedbackConfig old = impl_->config.feedback;
-  keep.feedback = b;
-  if (impl_->sinks_open) {
-    // The sinks stay as opened; only the policy's tunables change now.
-    keep.feedback.audio_enabled = old.audio_enabled;
-    keep.feedback.audio_device = old.audio_device;
-    keep.feedback.sounds_dir = old.sounds_dir;
-    keep.feedback.volume = old.volume;
-    keep.feedback.stereo_pan = old.stereo_pan;
-    keep.feedback.haptic_enabled = old.haptic_enabled;
-    keep.feedback.gpio_chip = old.gpio_chip;
-    keep.feedback.gpio_line = old.gpio_line;
-    keep.feedback.language = old.language;
-  }
-  if (impl_->button_tried) {
-    keep.feedback.button_enabled = old.button_enabled;
-    keep.feedback.button_chip = old.button_chip;
-    keep.feedback.button_line = old.button_line;
-    keep.feedback.button_active_low = old.button_active_low;
-    keep.feedback.button_debounce = old.button_debounce;
-    keep.feedback.button_long_press = old.button_long_press;
-    keep.feedback.button_double_press = old.button_double_press;
-  }
+  device_settings(keep.feedback, a, [&](auto& kept, const auto& old, bool button) {
+    if (button ? impl_->button_tried : impl_->sinks_open) kept = old;
+  });
   impl_->config = keep;
   impl_->policy.reconfigure(keep.feedback);
 }

@@ -3,7 +3,9 @@
 // paper's parameters (section 3.1: VoxelGrid 4 cm, NormalEstimation r = 5 cm, RegionGrowing
 // 6 deg / 0.5 / 50, RANSAC planarity > 80 %, EuclideanClusterExtraction), on the same frames in
 // the same process, one thread. Wall time (steady clock) and thread CPU time are both reported:
-// on a shared machine the CPU time is the steadier of the two.
+// on a shared machine the CPU time is the steadier of the two. The drop-off stage, which the
+// runtime runs on every perceived frame after these (stairs/drop_detection.hpp), is timed on its
+// own on each frame's scene and given as its share of ours (medians of the same run).
 // INPUT: anything `analyze` reads (a dataset folder, FILE.oni, FILE.pcd, ...), a folder of .pcd
 // frames, or a list file (.txt / .list: one such input per line, relative to the list, # for
 // comments), so that single real frames can be benchmarked together.
@@ -35,6 +37,7 @@
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/capture/synth_source.hpp"
 #include "stairguide/perception/perception.hpp"
+#include "stairguide/stairs/drop_detection.hpp"
 
 namespace stairguide::cli {
 namespace {
@@ -274,7 +277,8 @@ int bench_perception(Context& ctx) {
   std::vector<double> o_wall, o_cpu, o_seg, o_floor, o_man, o_cls;
   std::vector<double> s_cells, s_seeds, s_strips;
   std::vector<double> s_bp, s_grow, s_merge, s_refine, s_fin, s_cl, o_regions, r_regions;
-  int floors = 0;
+  std::vector<double> d_wall, d_cpu;  // the drop stage
+  int floors = 0, drops = 0;
   Reference ref;
   ref.cfg = ctx.config.segmentation;
   FloorDetector ref_floor(ctx.config.floor);
@@ -304,6 +308,13 @@ int bench_perception(Context& ctx) {
     s_cl.push_back(st.clusters_ms);
     floors += scene.floor_found;
     o_regions.push_back(static_cast<double>(scene.regions.size()));
+    // The drop stage as PerceptionStage::step runs it, on this frame's scene (the runtime may
+    // carry a floor the frame's own view lacks; here every frame stands alone, as for ours).
+    Timer td;
+    const DropResult drop = detect_drop(f, scene, ctx.config.drops);
+    d_cpu.push_back(td.cpu());
+    d_wall.push_back(td.wall());
+    drops += drop.detected;  // edges found by the stage (a descent's is vetoed later, by the stairs')
   };
   auto run_reference = [&](const RgbdFrame& f) {
     ref_floor.reset();
@@ -342,6 +353,9 @@ int bench_perception(Context& ctx) {
   const double rmed = percentile(r_wall, 0.5), rp95 = percentile(r_wall, 0.95);
   const double cmed = percentile(o_cpu, 0.5), cp95 = percentile(o_cpu, 0.95), rcmed = percentile(r_cpu, 0.5);
   const double ratio = med > 0 ? rmed / med : 0.0, cratio = cmed > 0 ? rcmed / cmed : 0.0;
+  const double dmed = percentile(d_wall, 0.5), dp95 = percentile(d_wall, 0.95),
+               dcmed = percentile(d_cpu, 0.5);
+  const double dshare = med > 0 ? dmed / med : 0.0, dcshare = cmed > 0 ? dcmed / cmed : 0.0;
   const int W = frames[0].depth.cols, H = frames[0].depth.rows;
   if (json) {
     std::printf(
@@ -355,11 +369,14 @@ int bench_perception(Context& ctx) {
         "\"reference_normals_median_ms\": %.3f, \"reference_growing_median_ms\": %.3f, "
         "\"reference_ransac_median_ms\": %.3f, \"reference_clusters_median_ms\": %.3f, "
         "\"ours_floor_found\": %d, \"reference_floor_found\": %d, \"ours_regions_median\": %.0f, "
-        "\"reference_regions_median\": %.0f}\n",
+        "\"reference_regions_median\": %.0f, \"ours_drop_median_ms\": %.3f, \"ours_drop_p95_ms\": %.3f, "
+        "\"ours_drop_cpu_median_ms\": %.3f, \"drop_share\": %.4f, \"drop_cpu_share\": %.4f, "
+        "\"ours_drop_found\": %d}\n",
         frames.size(), W, H, med, p95, cmed, cp95, rmed, rp95, rcmed, ratio, cratio, percentile(o_seg, 0.5),
         percentile(o_floor, 0.5), percentile(o_man, 0.5), percentile(o_cls, 0.5), percentile(r_vox, 0.5),
         percentile(r_norm, 0.5), percentile(r_grow, 0.5), percentile(r_ransac, 0.5), percentile(r_clu, 0.5),
-        floors, ref_floors, percentile(o_regions, 0.5), percentile(r_regions, 0.5));
+        floors, ref_floors, percentile(o_regions, 0.5), percentile(r_regions, 0.5), dmed, dp95, dcmed, dshare,
+        dcshare, drops);
     return 0;
   }
   std::printf("perception bench: %zu frames %dx%d, one thread\n", frames.size(), W, H);
@@ -377,6 +394,10 @@ int bench_perception(Context& ctx) {
       percentile(s_refine, 0.5), percentile(s_fin, 0.5), percentile(s_cl, 0.5), percentile(o_floor, 0.5),
       percentile(o_man, 0.5), percentile(o_cls, 0.5));
   std::printf(
+      "  drop stage wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | %.1f%% of ours (wall), %.1f%% "
+      "(cpu) | drop on %d\n",
+      dmed, dp95, dcmed, 100.0 * dshare, 100.0 * dcshare, drops);
+  std::printf(
       "  reference  wall median %8.3f ms  p95 %8.3f ms | cpu median %8.3f ms | floor on %d | regions median "
       "%.0f\n",
       rmed, rp95, rcmed, ref_floors, percentile(r_regions, 0.5));
@@ -390,6 +411,7 @@ int bench_perception(Context& ctx) {
 }  // namespace
 
 SG_BENCH("perception", "perception [--frames DIR|FILE|LIST.txt] [--count N] [--json] [--checksum]",
-         "segmentation+floor+Manhattan+classification vs the paper's PCL pipeline", bench_perception);
+         "segmentation+floor+Manhattan+classification vs the paper's PCL pipeline; the drop stage's share",
+         bench_perception);
 
 }  // namespace stairguide::cli

@@ -42,6 +42,9 @@
 #include "stairguide/feedback/cue.hpp"
 #include "stairguide/feedback/haptic.hpp"
 #include "stairguide/feedback/sound_bank.hpp"
+#include "stairguide/runtime/devices/alsa_audio_sink.hpp"
+#include "stairguide/runtime/devices/button_reader.hpp"
+#include "stairguide/runtime/devices/haptic_player.hpp"
 
 namespace stairguide::cli {
 namespace {
@@ -205,16 +208,16 @@ Check check_sound(const FeedbackConfig& cfg) {
   bank.clips["doctor_tone"] = tone;
   std::mutex m;
   std::string warning;
-  feedback::AudioEvents ev;
+  runtime::devices::AudioEvents ev;
   ev.warn = [&](const std::string& w) {
     std::lock_guard<std::mutex> lk(m);
     if (warning.empty()) warning = w;
   };
-  feedback::AlsaSinkOptions opt;
+  runtime::devices::AlsaSinkOptions opt;
   opt.device = cfg.audio_device;
   opt.retry_s = 60.0;  // one attempt
   opt.max_age_s = 2.0;
-  feedback::AlsaAudioSink sink(opt, bank, ev);
+  runtime::devices::AlsaAudioSink sink(opt, bank, ev);
   feedback::Utterance u;
   u.id = 1;
   u.clips = {"doctor_tone"};
@@ -222,7 +225,7 @@ Check check_sound(const FeedbackConfig& cfg) {
   u.queued = feedback::SteadyClock::now();
   sink.play(u);
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(3);
-  feedback::AlsaAudioSink::Counters k;
+  runtime::devices::AlsaAudioSink::Counters k;
   for (;;) {
     k = sink.counters();
     if (k.played > 0 || k.open_failures > 0 || std::chrono::steady_clock::now() > until) break;
@@ -249,64 +252,70 @@ Check check_sound(const FeedbackConfig& cfg) {
   return c;
 }
 
-// ---- 4. buzzer -------------------------------------------------------------------------------
+// ---- 4. buzzer and 4b. button: GPIO lines, requested as the daemon requests them ---------------
 
-Check check_buzzer(const FeedbackConfig& cfg) {
-  Check c{"buzzer"};
-  if (!cfg.haptic_enabled) {
-    c.status = Status::kInfo;
-    c.message = "the buzzer is off in the config (feedback.haptic_enabled: false): no vibration cues";
-    return c;
-  }
-  const bool file = cfg.gpio_chip.rfind("file:", 0) == 0;  // a test buzzer writing its edges to a file
-  const std::string where =
-      file ? "the buzzer's edge file " + cfg.gpio_chip.substr(5) + " (a test buzzer)"
-           : "GPIO line " + std::to_string(cfg.gpio_line) + " of '" + cfg.gpio_chip + "'";
+/// What names a GPIO device in the config and in its messages.
+struct GpioDevice {
+  const char* name;       ///< "buzzer"
+  const char* file_what;  ///< what its test backend's file holds ("edge file")
+  const char* room;       ///< the prefix of its errors ("haptic: ")
+  const char* key;        ///< its line is feedback.KEY_chip / KEY_line ...
+  const char* enabled;    ///< ... and feedback.ENABLED turns it off
+  const char* also;       ///< the last words of the fix
+};
+
+/// Checks the line of `dev` that `chip` and `line` name: `use` opens it as the daemon does and
+/// says what it did; the line's file when `chip` is "file:PATH" (a test device).
+template <class Use>
+Check check_gpio(const GpioDevice& dev, const std::string& chip, int line, Use use) {
+  Check c{dev.name};
+  const bool file = chip.rfind("file:", 0) == 0;
+  const std::string where = file ? std::string("the ") + dev.name + "'s " + dev.file_what + " " +
+                                       chip.substr(5) + " (a test " + dev.name + ")"
+                                 : "GPIO line " + std::to_string(line) + " of '" + chip + "'";
   try {
-    auto line = feedback::make_haptic_line(cfg.gpio_chip, cfg.gpio_line);
-    line->set(true);  // one 150 ms pulse: the helper can feel that this is the right line
-    std::this_thread::sleep_for(std::chrono::milliseconds(150));
-    line->set(false);
-    c.message = where + (file ? " written" : " requested") +
-                " and pulsed once for 150 ms: the wearer should have felt one buzz";
+    c.message = where + use(file);
   } catch (const std::exception& e) {
     c.status = Status::kFail;
     std::string why = e.what();
-    if (why.rfind("haptic: ", 0) == 0) why.erase(0, 8);
-    c.message = "cannot use the buzzer: " + why;
-    c.fix =
-        "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.gpio_chip and "
-        "feedback.gpio_line to the buzzer's (or feedback.haptic_enabled: false for none); a line "
-        "'used' by another program must be freed first";
+    if (why.rfind(dev.room, 0) == 0) why.erase(0, std::string(dev.room).size());
+    c.message = std::string("cannot use the ") + dev.name + ": " + why;
+    c.fix = std::string("'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.") +
+            dev.key + "_chip and feedback." + dev.key + "_line to the " + dev.name + "'s (or feedback." +
+            dev.enabled + ": false for none); " + dev.also;
   }
   return c;
+}
+
+Check check_buzzer(const FeedbackConfig& cfg) {
+  if (!cfg.haptic_enabled) {
+    Check c{"buzzer", Status::kInfo};
+    c.message = "the buzzer is off in the config (feedback.haptic_enabled: false): no vibration cues";
+    return c;
+  }
+  const GpioDevice dev{"buzzer", "edge file",      "haptic: ",
+                       "gpio",   "haptic_enabled", "a line 'used' by another program must be freed first"};
+  return check_gpio(dev, cfg.gpio_chip, cfg.gpio_line, [&](bool file) {
+    auto line = runtime::devices::make_haptic_line(cfg.gpio_chip, cfg.gpio_line);
+    line->set(true);  // one 150 ms pulse: the helper can feel that this is the right line
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    line->set(false);
+    return std::string(file ? " written" : " requested") +
+           " and pulsed once for 150 ms: the wearer should have felt one buzz";
+  });
 }
 
 // ---- 4b. the wearer's button (only when the config asks for one) ------------------------------
 
 Check check_button(const FeedbackConfig& cfg) {
-  Check c{"button"};
-  const bool file = cfg.button_chip.rfind("file:", 0) == 0;  // a test button reading presses from a file
-  const std::string where =
-      file ? "the button's presses file " + cfg.button_chip.substr(5) + " (a test button)"
-           : "GPIO line " + std::to_string(cfg.button_line) + " of '" + cfg.button_chip + "'";
-  try {
+  const GpioDevice dev{
+      "button", "presses file", "button: ", "button", "button_enabled", "the user must be in group gpio"};
+  return check_gpio(dev, cfg.button_chip, cfg.button_line, [&](bool file) {
     const auto line =
-        feedback::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
-    c.message =
-        where + (file ? " opened" : " requested for its edges") +
-        ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
-  } catch (const std::exception& e) {
-    c.status = Status::kFail;
-    std::string why = e.what();
-    if (why.rfind("button: ", 0) == 0) why.erase(0, 8);
-    c.message = "cannot use the button: " + why;
-    c.fix =
-        "'gpiodetect' lists the GPIO chips and 'gpioinfo CHIP' their lines: set feedback.button_chip and "
-        "feedback.button_line to the button's (or feedback.button_enabled: false for none); the user must "
-        "be in group gpio";
-  }
-  return c;
+        runtime::devices::make_button_line(cfg.button_chip, cfg.button_line, cfg.button_active_low, nullptr);
+    return std::string(file ? " opened" : " requested for its edges") +
+           ": the wearer's presses will be read (short: where are the stairs; long: mute; double: verbosity)";
+  });
 }
 
 // ---- 5. the service user ---------------------------------------------------------------------

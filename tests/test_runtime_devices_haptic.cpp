@@ -12,8 +12,10 @@
 #include <thread>
 
 #include "stairguide/feedback/haptic.hpp"
+#include "stairguide/runtime/devices/haptic_player.hpp"
 
 using namespace stairguide::feedback;
+using namespace stairguide::runtime::devices;
 using Clock = std::chrono::steady_clock;
 
 namespace {

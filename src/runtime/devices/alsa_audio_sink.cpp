@@ -7,9 +7,14 @@
 #include <cmath>
 #include <cstdarg>
 
-#include "stairguide/feedback/audio_sink.hpp"
+#include "stairguide/runtime/devices/alsa_audio_sink.hpp"
 
-namespace stairguide::feedback {
+namespace stairguide::runtime::devices {
+
+using feedback::Delivery;
+using feedback::kSoundRate;
+using feedback::pan_gains;
+using feedback::Utterance;
 
 namespace {
 snd_pcm_t* as_pcm(void* p) { return static_cast<snd_pcm_t*>(p); }
@@ -24,14 +29,7 @@ constexpr std::size_t kMaxMix = 4;
 constexpr int kRealtimePriority = 10;
 }  // namespace
 
-void pan_gains(float pan, float& left, float& right) {
-  const double p = std::clamp(std::isfinite(pan) ? static_cast<double>(pan) : 0.0, -1.0, 1.0);
-  const double a = (p + 1.0) * M_PI / 4.0;  // 0 (left) .. pi/2 (right)
-  left = static_cast<float>(std::cos(a));
-  right = static_cast<float>(std::sin(a));
-}
-
-AlsaAudioSink::AlsaAudioSink(AlsaSinkOptions options, SoundBank bank, AudioEvents events)
+AlsaAudioSink::AlsaAudioSink(AlsaSinkOptions options, feedback::SoundBank bank, AudioEvents events)
     : opt_(std::move(options)), bank_(std::move(bank)), ev_(std::move(events)) {
   opt_.chunk_frames = std::max(16u, opt_.chunk_frames);
   snd_lib_error_set_handler(quiet_alsa);
@@ -383,4 +381,4 @@ void AlsaAudioSink::run() {
   }
 }
 
-}  // namespace stairguide::feedback
+}  // namespace stairguide::runtime::devices
