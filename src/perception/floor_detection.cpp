@@ -76,7 +76,8 @@ void FloorDetector::sample_frame(const RgbdFrame& frame) {
   }
 }
 
-bool FloorDetector::nothing_below(const PlaneRegion& r, const Reach& near) const {
+bool FloorDetector::nothing_below(const PlaneRegion& r, const Reach& near,
+                                  const std::vector<float>& descent) const {
   // The user stands on the floor: nothing the camera sees nearer the user's feet (nearer the
   // nadir) than the floor itself can lie clearly below it. A tread, a platform, a seat or a bed
   // seen from in front has its front face (a riser, the seat's front) or the real floor under its
@@ -90,6 +91,14 @@ bool FloorDetector::nothing_below(const PlaneRegion& r, const Reach& near) const
     const float h = r.normal.dot(q) + r.offset;  // height above the candidate plane
     if (h > -cfg_.verify_drop) continue;
     if (nadir_tan(r.normal, q) >= t) continue;
+    if (below_any_floor(r.normal, q)) continue;
+    // The levels of a descent starting at r's level (its first tread refused as the middle of a
+    // stack, r the bigger level a riser above it): seen cold at the top of a flight, the first
+    // tread fills the bottom of the view between the floor's pieces beside the stairwell, as near
+    // the view's edge as they are. That is the drop ahead of the user, not what r stands on.
+    if (std::any_of(descent.begin(), descent.end(),
+                    [&](float d) { return std::fabs(h - d) < cfg_.inlier_distance; }))
+      continue;
     below += sample_weight_;
   }
   return below < static_cast<float>(cfg_.verify_min_pixels);
@@ -120,7 +129,7 @@ bool FloorDetector::drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame
       const Eigen::Vector3f q(un * z, (static_cast<float>(v) - K.cy) / K.fy * z, z);
       const float h = r.normal.dot(q) + r.offset;
       if (h < -kDrop) {
-        drop_row = v;
+        if (!below_any_floor(r.normal, q)) drop_row = v;
         continue;
       }
       if (h > cfg_.inlier_distance) continue;
@@ -141,6 +150,8 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
   FloorEstimate est;
   clear_height_.reset();
   refused_as_tread_ = false;
+  descent_tread_.reset();
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
   const int n = static_cast<int>(regions.size());
   const float area_k = 1.f / (frame.intrinsics.fx * frame.intrinsics.fy);
   // The tracked floor, unless this is a cold probe (what would a fresh start take?).
@@ -209,14 +220,29 @@ FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, con
     if (chosen < 0) break;
     const PlaneRegion& f = regions[chosen];
     const Reach near = reach(f);
-    const bool clear = nothing_below(f, near) && !drop_under_edge(f, frame);
+    // Cold, the level seen under the camera and behind its foot is what the user stands on: the
+    // checks below tell a tread or a seat from the floor by what lies between it and the user's
+    // feet, and nothing does.
+    const bool under = !tracked && under_the_camera(regions, chosen);
+    // A descent found to start at this level (its first tread refused as the middle of a stack,
+    // this level the bigger one a riser above it, reaching the view's edge as near as that tread).
+    descent_levels_.clear();
+    if (descent_tread_ && near.angle <= descent_tread_->angle + cfg_.view_edge_angle) {
+      const float rise = descent_tread_->offset - f.offset;
+      if (rise >= cfg_.ambiguous_rise_min && rise <= cfg_.ambiguous_rise_max)
+        for (const PlaneRegion& L : regions)
+          if (L.normal.dot(f.normal) >= cos_par && L.offset >= descent_tread_->offset - cfg_.inlier_distance)
+            descent_levels_.push_back(f.offset - L.offset);
+    }
+    const bool clear = under || (nothing_below(f, near, descent_levels_) && !drop_under_edge(f, frame));
     // The tracked floor has been told from the steps already: no ambiguity left.
     stack_below_ = false;
-    const bool stair = clear && !tracked &&
+    const bool stair = clear && !tracked && !under &&
                        (stair_from_view_edge(regions, chosen, near, frame.depth.cols) ||
                         middle_of_stack(regions, chosen, near));
+    if (stair && stack_below_) descent_tread_ = DescentTread{f.offset, near.angle};
     // Cold, passing every other check: the user may stand on a level above it at the view's edge.
-    if (clear && !stair && !tracked &&
+    if (clear && !stair && !tracked && !under &&
         level_above_underfoot(regions, chosen, frame.depth.cols, frame.depth.rows)) {
       est.level_region = chosen;
       est.why = "the user may stand on the level above, seen at the view's edge";

@@ -199,6 +199,49 @@ bool FloorDetector::tread_shaped(const std::vector<PlaneRegion>& regions, const 
   return c_d.hi - c_d.lo <= a_d.hi - a_d.lo + cfg_.floor_deeper_than_tread;
 }
 
+bool FloorDetector::under_the_camera(const std::vector<PlaneRegion>& regions, int c) const {
+  // A camera tilted steeply enough (about 65 deg and more for a Kinect's 46 deg of vertical field)
+  // has the nadir in view: the point under it, near the user's feet, and a strip behind it
+  // towards the heels. A level seen there, with no other level beside it behind the nadir, is
+  // what the user stands on: a tread, a seat or a table top is told from the floor by what lies
+  // between it and the user's feet (a riser, a front face, the floor under its edge), and nothing
+  // can. Ahead of the feet it may have drops (the first tread of a descent at the user's toes) and
+  // steps, which the other checks would take it for a tread of. Seen only ahead of the nadir, a
+  // level may be a tread the chest overhangs (standing at the foot of a flight, the camera over
+  // its first tread): that needs the heels' side, and is left to the other checks.
+  constexpr float kBehind = 0.10f;      // m behind the camera's foot: the heels' side, beyond noise
+  constexpr float kMinBehind = 0.04f;   // m^2 of the level seen there (a strip 0.4 m wide, 0.1 m deep)
+  constexpr float kOtherShare = 0.15f;  // other levels seen there, at most this share of it
+  const PlaneRegion& C = regions[c];
+  if (C.points.empty() || K_.width <= 0 || K_.height <= 0) return false;
+  const Eigen::Vector3f down = -C.normal;  // the nadir's direction, camera frame
+  if (down.z() <= 1e-3f) return false;
+  const float u = K_.fx * down.x() / down.z() + K_.cx, v = K_.fy * down.y() / down.z() + K_.cy;
+  if (u < 0.f || v < 0.f || u > static_cast<float>(K_.width - 1) || v > static_cast<float>(K_.height - 1))
+    return false;
+  Eigen::Vector3f fwd = Eigen::Vector3f::UnitZ() - C.normal * C.normal.z();  // the camera's forward, levelled
+  if (fwd.norm() < 1e-3f) fwd = Eigen::Vector3f::UnitY() - C.normal * C.normal.y();  // looking straight down
+  fwd.normalize();
+  const float cos_par = std::cos(cfg_.horizontal_tolerance);
+  float on = 0.f, other = 0.f;
+  for (const PlaneRegion& L : regions) {
+    if (L.points.empty() || L.normal.dot(C.normal) < cos_par) continue;
+    const bool same = std::fabs(L.offset - C.offset) <= cfg_.inlier_distance;
+    const float per_point = L.area / static_cast<float>(L.points.size());
+    float behind = 0.f;
+    for (const auto& q : L.points)
+      if (fwd.dot(q) < -kBehind) behind += per_point;
+    (same ? on : other) += behind;
+  }
+  if (on < kMinBehind || other > kOtherShare * on) return false;
+  // Nor anything clearly lower behind the nadir (the floor under a table's edge the chest leans
+  // over): the sparse grid of the frame, whatever its segmentation.
+  float lower = 0.f;
+  for (const auto& q : samples_)
+    if (fwd.dot(q) < -kBehind && C.normal.dot(q) + C.offset < -cfg_.verify_drop) lower += sample_weight_;
+  return lower < static_cast<float>(cfg_.verify_min_pixels);
+}
+
 bool FloorDetector::middle_of_stack(const std::vector<PlaneRegion>& regions, int c, const Reach& near) {
   // A plane with a bigger level one riser above it (anywhere in view) and another one riser below
   // it, starting beyond its near edge within its width: the first tread of a descent, the floor

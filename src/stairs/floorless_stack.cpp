@@ -8,6 +8,7 @@
 
 #include "floorless_internal.hpp"
 #include "stairguide/stairs/floorless.hpp"
+#include "stairguide/stairs/stair_checks.hpp"
 
 namespace stairguide {
 
@@ -164,7 +165,7 @@ void FloorlessStairs::build_stack() {
   // ---- the longest stack of levels one riser apart, each connected to the one below ----
   const std::size_t m = order_.size();
   const float hmin = cls_.step_height_min - det_.height_tolerance;
-  const float hmax = cls_.step_height_max + det_.height_tolerance;
+  const float hmax = step_rise_max(cls_) + det_.height_tolerance;
   best_len_.assign(m, 1);
   best_prev_.assign(m, -1);
   best_pix_.assign(m, 0);
@@ -176,7 +177,7 @@ void FloorlessStairs::build_stack() {
       const float dh = b.height - a.height;
       if (dh < hmin || dh > hmax) continue;
       // A flight has one riser: the next level lies as far above this one as this one above the
-      // level below it, within same_level_tolerance. With the world's riser range (8-24 cm with
+      // level below it, within same_level_tolerance. With the physical riser range (8-27 cm with
       // the slack) a seat 9 cm above the last tread of a 19 cm flight would otherwise stack on it
       // (the open-riser captures of labels.csv, a chair in front).
       if (best_prev_[i] >= 0) {

@@ -158,8 +158,18 @@ class FloorDetector {
   int relearn_misses_ = 0;
   int lost_frames_ = 0;
   void sample_frame(const RgbdFrame& frame);
-  bool nothing_below(const PlaneRegion& r, const Reach& near) const;
+  // `descent`: the relative heights (m, negative: below r) of the levels of a descent found to start
+  // at r's level (a refused first tread and what lies below it); points on them are not "below".
+  bool nothing_below(const PlaneRegion& r, const Reach& near, const std::vector<float>& descent) const;
   bool drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame) const;
+  // Lower than any floor of the rig range: a drop (a hole, a dock, a stairwell), never the front of
+  // a seat or a step standing on the user's floor, nor that floor.
+  bool below_any_floor(const Eigen::Vector3f& up, const Eigen::Vector3f& q) const {
+    return -up.dot(q) > cfg_.height_max + cfg_.verify_drop;
+  }
+  // Candidate c's level is seen under the camera: the nadir is in view and, behind it (towards
+  // the user's heels), c's level is what the camera sees, no other level.
+  bool under_the_camera(const std::vector<PlaneRegion>& regions, int c) const;
   bool stair_from_view_edge(const std::vector<PlaneRegion>& regions, int c, const Reach& near, int width);
   std::vector<int> col_top_;
   struct Span {
@@ -189,6 +199,13 @@ class FloorDetector {
       curb_edge_;  // ... the upper level's points and its edge with F (floor frame x, z)
   std::vector<float> lateral_;
   bool stack_below_ = false;  // middle_of_stack said so: every lower plane is a tread too
+  // The descent middle_of_stack found last (its first tread's plane offset), while choosing.
+  struct DescentTread {
+    float offset;  // m, its plane's offset
+    float angle;   // rad, its near edge from the nadir
+  };
+  std::optional<DescentTread> descent_tread_;
+  std::vector<float> descent_levels_;  // scratch: nothing_below's `descent`
   CameraIntrinsics K_;
 
   FloorConfig cfg_;

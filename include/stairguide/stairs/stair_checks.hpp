@@ -29,6 +29,16 @@ struct WalkableLimits {
   float width_cut_min = 0.30f;  ///< m, a width cut by the view (a lower bound) must still reach this
 };
 
+/// The highest rise taken for one step when levels are stacked into a flight: the physical limit
+/// (WalkableLimits::riser_max, 25 cm) or the configured H_max when that is higher. The building
+/// code's H_max (22 cm) only describes a flight (describe_against_code): a cellar or attic stair
+/// with 24 cm risers is walked every day, and stacking it on the code's limit left every level
+/// but the floor unconnected ("no first step connected to the floor", 4 of 6 steep misses on
+/// world2 seeds 912-913).
+inline float step_rise_max(const ClassificationConfig& cls) {
+  return cls.step_height_max > WalkableLimits{}.riser_max ? cls.step_height_max : WalkableLimits{}.riser_max;
+}
+
 /// Measured dimensions of a modelled staircase, as the checks need them.
 struct StairDimensions {
   float riser = 0.f;            ///< m
