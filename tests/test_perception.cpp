@@ -369,14 +369,10 @@ using sg_test::wrap45;
 // Height of the tread surface above the stair's base floor, and in the stair frame.
 float tread_height(const StairTruth& s, int k) {
   switch (s.kind) {
-    case StairKind::kAscending:
-      return k * s.riser_m;
-    case StairKind::kDescending:
-      return -k * s.riser_m;
-    case StairKind::kSingleStep:
-      return s.riser_m;
-    default:
-      return 0.f;
+    case StairKind::kAscending: return k * s.riser_m;
+    case StairKind::kDescending: return -k * s.riser_m;
+    case StairKind::kSingleStep: return s.riser_m;
+    default: return 0.f;
   }
 }
 bool stair_goes_up(const StairTruth& s) {

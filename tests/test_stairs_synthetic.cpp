@@ -44,24 +44,15 @@ enum class Cause {
 };
 const char* to_string(Cause c) {
   switch (c) {
-    case Cause::kNoFloorInView:
-      return "perception: no floor (little in view)";
-    case Cause::kNoFloorFound:
-      return "perception: no floor (floor in view)";
-    case Cause::kFloorDoubtful:
-      return "stairs: floor doubtful";
-    case Cause::kNoCandidates:
-      return "perception: no step candidates";
-    case Cause::kStage:
-      return "stairs: rejected";
-    case Cause::kWrongDirection:
-      return "stairs: wrong direction";
-    case Cause::kElsewhere:
-      return "stairs: detection off the edge";
-    case Cause::kFloorless:
-      return "stairs floorless: off the edge";
-    case Cause::kKind:
-      return "stairs: kind (flight vs one step)";
+    case Cause::kNoFloorInView: return "perception: no floor (little in view)";
+    case Cause::kNoFloorFound: return "perception: no floor (floor in view)";
+    case Cause::kFloorDoubtful: return "stairs: floor doubtful";
+    case Cause::kNoCandidates: return "perception: no step candidates";
+    case Cause::kStage: return "stairs: rejected";
+    case Cause::kWrongDirection: return "stairs: wrong direction";
+    case Cause::kElsewhere: return "stairs: detection off the edge";
+    case Cause::kFloorless: return "stairs floorless: off the edge";
+    case Cause::kKind: return "stairs: kind (flight vs one step)";
   }
   return "?";
 }

@@ -46,29 +46,14 @@ std::string describe_mat_type(const cv::Mat& m) {
   if (m.empty()) return "empty";
   const char* depth = "?";
   switch (m.depth()) {
-    case CV_8U:
-      depth = "8-bit";
-      break;
-    case CV_8S:
-      depth = "8-bit signed";
-      break;
-    case CV_16U:
-      depth = "16-bit";
-      break;
-    case CV_16S:
-      depth = "16-bit signed";
-      break;
-    case CV_32S:
-      depth = "32-bit integer";
-      break;
-    case CV_32F:
-      depth = "32-bit float";
-      break;
-    case CV_64F:
-      depth = "64-bit float";
-      break;
-    default:
-      break;
+    case CV_8U: depth = "8-bit"; break;
+    case CV_8S: depth = "8-bit signed"; break;
+    case CV_16U: depth = "16-bit"; break;
+    case CV_16S: depth = "16-bit signed"; break;
+    case CV_32S: depth = "32-bit integer"; break;
+    case CV_32F: depth = "32-bit float"; break;
+    case CV_64F: depth = "64-bit float"; break;
+    default: break;
   }
   return std::string(depth) + " " + std::to_string(m.channels()) + "-channel";
 }
@@ -89,19 +74,13 @@ cv::Mat depth_to_u16(const cv::Mat& depth_m, double scale) {
 
 std::string errno_words(int err) {
   switch (err) {
-    case ENOENT:
-      return "no such file";
+    case ENOENT: return "no such file";
     case EACCES:
-    case EPERM:
-      return "permission denied";
-    case ELOOP:
-      return "a symbolic link loop (too many levels of symbolic links)";
-    case ENOTDIR:
-      return "not a directory (a component of the path)";
-    case ENAMETOOLONG:
-      return "file name too long";
-    default:
-      return std::strerror(err);
+    case EPERM: return "permission denied";
+    case ELOOP: return "a symbolic link loop (too many levels of symbolic links)";
+    case ENOTDIR: return "not a directory (a component of the path)";
+    case ENAMETOOLONG: return "file name too long";
+    default: return std::strerror(err);
   }
 }
 

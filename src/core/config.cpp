@@ -10,47 +10,29 @@ namespace stairguide {
 
 double unit_to_si(Unit u) {
   switch (u) {
-    case Unit::kCentimetre:
-      return 0.01;
-    case Unit::kMillimetre:
-      return 0.001;
-    case Unit::kDegree:
-      return M_PI / 180.0;
-    case Unit::kPercent:
-      return 0.01;
-    case Unit::kMillisecond:
-      return 0.001;
-    default:
-      return 1.0;
+    case Unit::kCentimetre: return 0.01;
+    case Unit::kMillimetre: return 0.001;
+    case Unit::kDegree: return M_PI / 180.0;
+    case Unit::kPercent: return 0.01;
+    case Unit::kMillisecond: return 0.001;
+    default: return 1.0;
   }
 }
 
 const char* unit_name(Unit u) {
   switch (u) {
-    case Unit::kMetre:
-      return "m";
-    case Unit::kCentimetre:
-      return "cm";
-    case Unit::kMillimetre:
-      return "mm";
-    case Unit::kDegree:
-      return "deg";
-    case Unit::kPercent:
-      return "%";
-    case Unit::kSecond:
-      return "s";
-    case Unit::kMillisecond:
-      return "ms";
-    case Unit::kHertz:
-      return "Hz";
-    case Unit::kPerMetre:
-      return "1/m";
-    case Unit::kPixel:
-      return "px";
-    case Unit::kCount:
-      return "";
-    case Unit::kNone:
-      return "";
+    case Unit::kMetre: return "m";
+    case Unit::kCentimetre: return "cm";
+    case Unit::kMillimetre: return "mm";
+    case Unit::kDegree: return "deg";
+    case Unit::kPercent: return "%";
+    case Unit::kSecond: return "s";
+    case Unit::kMillisecond: return "ms";
+    case Unit::kHertz: return "Hz";
+    case Unit::kPerMetre: return "1/m";
+    case Unit::kPixel: return "px";
+    case Unit::kCount: return "";
+    case Unit::kNone: return "";
   }
   return "";
 }

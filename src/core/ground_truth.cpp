@@ -4,16 +4,11 @@ namespace stairguide {
 
 const char* to_string(StairKind k) {
   switch (k) {
-    case StairKind::kNone:
-      return "none";
-    case StairKind::kAscending:
-      return "ascending";
-    case StairKind::kDescending:
-      return "descending";
-    case StairKind::kSingleStep:
-      return "single_step";
-    case StairKind::kCurb:
-      return "curb";
+    case StairKind::kNone: return "none";
+    case StairKind::kAscending: return "ascending";
+    case StairKind::kDescending: return "descending";
+    case StairKind::kSingleStep: return "single_step";
+    case StairKind::kCurb: return "curb";
   }
   return "none";
 }

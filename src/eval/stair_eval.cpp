@@ -12,16 +12,11 @@ namespace stairguide {
 
 const char* to_string(EvalOutcome o) {
   switch (o) {
-    case EvalOutcome::kTP:
-      return "TP";
-    case EvalOutcome::kFP:
-      return "FP";
-    case EvalOutcome::kTN:
-      return "TN";
-    case EvalOutcome::kFN:
-      return "FN";
-    case EvalOutcome::kSkipped:
-      return "skipped";
+    case EvalOutcome::kTP: return "TP";
+    case EvalOutcome::kFP: return "FP";
+    case EvalOutcome::kTN: return "TN";
+    case EvalOutcome::kFN: return "FN";
+    case EvalOutcome::kSkipped: return "skipped";
   }
   return "?";
 }
@@ -54,16 +49,11 @@ const char* kind_label(StairKind kind, bool down) {
 
 static const char* kind_class(StairKind kind, bool down) {
   switch (kind) {
-    case StairKind::kAscending:
-      return "flight_up";
-    case StairKind::kDescending:
-      return "flight_down";
-    case StairKind::kSingleStep:
-      return "one_step_up";
-    case StairKind::kCurb:
-      return down ? "one_step_down" : "one_step_up";
-    default:
-      return "none";
+    case StairKind::kAscending: return "flight_up";
+    case StairKind::kDescending: return "flight_down";
+    case StairKind::kSingleStep: return "one_step_up";
+    case StairKind::kCurb: return down ? "one_step_down" : "one_step_up";
+    default: return "none";
   }
 }
 
@@ -197,20 +187,11 @@ double ErrorStats::sigma() const {
 void EvalSummary::add(const StairFrameEval& e) {
   ++frames;
   switch (e.outcome) {
-    case EvalOutcome::kTP:
-      ++tp;
-      break;
-    case EvalOutcome::kTN:
-      ++tn;
-      break;
-    case EvalOutcome::kFN:
-      ++fn;
-      break;
-    case EvalOutcome::kFP:
-      break;
-    case EvalOutcome::kSkipped:
-      ++skipped;
-      break;
+    case EvalOutcome::kTP: ++tp; break;
+    case EvalOutcome::kTN: ++tn; break;
+    case EvalOutcome::kFN: ++fn; break;
+    case EvalOutcome::kFP: break;
+    case EvalOutcome::kSkipped: ++skipped; break;
   }
   if (e.outcome == EvalOutcome::kFP || e.false_positive) ++fp;
   if (e.wrong_direction) ++wrong_direction;

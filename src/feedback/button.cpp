@@ -7,12 +7,9 @@ namespace stairguide::feedback {
 
 const char* to_string(Press p) {
   switch (p) {
-    case Press::kShort:
-      return "short";
-    case Press::kLong:
-      return "long";
-    case Press::kDouble:
-      return "double";
+    case Press::kShort: return "short";
+    case Press::kLong: return "long";
+    case Press::kDouble: return "double";
   }
   return "?";
 }

@@ -14,50 +14,28 @@ bool sayable(int n) { return n >= 1 && n <= kMaxNumber; }
 
 const char* to_string(Cue c) {
   switch (c) {
-    case Cue::kReady:
-      return "ready";
-    case Cue::kCameraLost:
-      return "camera_lost";
-    case Cue::kCameraBack:
-      return "camera_back";
-    case Cue::kBlind:
-      return "blind";
-    case Cue::kStairsAhead:
-      return "stairs_ahead";
-    case Cue::kDropWarning:
-      return "drop_warning";
-    case Cue::kStepAhead:
-      return "step_ahead";
-    case Cue::kFirstStep:
-      return "first_step";
-    case Cue::kTick:
-      return "tick";
-    case Cue::kCount:
-      return "count";
-    case Cue::kStepsLeft:
-      return "steps_left";
-    case Cue::kLastStep:
-      return "last_step";
-    case Cue::kEndOfStairs:
-      return "end_of_stairs";
-    case Cue::kApproach:
-      return "approach";
-    case Cue::kBatteryLow:
-      return "battery_low";
-    case Cue::kBatteryCritical:
-      return "battery_critical";
-    case Cue::kSlow:
-      return "slow";
-    case Cue::kWhere:
-      return "where";
-    case Cue::kMuted:
-      return "muted";
-    case Cue::kUnmuted:
-      return "unmuted";
-    case Cue::kVerbosity:
-      return "verbosity";
-    case Cue::kDropAhead:
-      return "drop_ahead";
+    case Cue::kReady: return "ready";
+    case Cue::kCameraLost: return "camera_lost";
+    case Cue::kCameraBack: return "camera_back";
+    case Cue::kBlind: return "blind";
+    case Cue::kStairsAhead: return "stairs_ahead";
+    case Cue::kDropWarning: return "drop_warning";
+    case Cue::kStepAhead: return "step_ahead";
+    case Cue::kFirstStep: return "first_step";
+    case Cue::kTick: return "tick";
+    case Cue::kCount: return "count";
+    case Cue::kStepsLeft: return "steps_left";
+    case Cue::kLastStep: return "last_step";
+    case Cue::kEndOfStairs: return "end_of_stairs";
+    case Cue::kApproach: return "approach";
+    case Cue::kBatteryLow: return "battery_low";
+    case Cue::kBatteryCritical: return "battery_critical";
+    case Cue::kSlow: return "slow";
+    case Cue::kWhere: return "where";
+    case Cue::kMuted: return "muted";
+    case Cue::kUnmuted: return "unmuted";
+    case Cue::kVerbosity: return "verbosity";
+    case Cue::kDropAhead: return "drop_ahead";
   }
   return "?";
 }
@@ -69,10 +47,8 @@ bool marks_a_step(Cue c) {
     case Cue::kCount:
     case Cue::kStepsLeft:
     case Cue::kLastStep:
-    case Cue::kEndOfStairs:
-      return true;
-    default:
-      return false;
+    case Cue::kEndOfStairs: return true;
+    default: return false;
   }
 }
 
@@ -80,39 +56,29 @@ int cue_priority(Cue c) {
   // Step feedback is the lowest (a newer step makes an old tick stale); what is ahead comes next;
   // the system's own blindness and the last step are warnings; a drop ahead is the highest.
   switch (c) {
-    case Cue::kTick:
-      return 1;
-    case Cue::kCount:
-      return 2;
-    case Cue::kReady:
-      return 3;
+    case Cue::kTick: return 1;
+    case Cue::kCount: return 2;
+    case Cue::kReady: return 3;
     case Cue::kStairsAhead:
     case Cue::kStepAhead:
     case Cue::kFirstStep:
     case Cue::kStepsLeft:
     case Cue::kEndOfStairs:
-    case Cue::kCameraBack:
-      return 4;
+    case Cue::kCameraBack: return 4;
     case Cue::kApproach:
     case Cue::kSlow:
     // The answers to a press: the wearer asked, and waits for them.
     case Cue::kWhere:
     case Cue::kMuted:
     case Cue::kUnmuted:
-    case Cue::kVerbosity:
-      return 5;
-    case Cue::kBatteryLow:
-      return 3;
-    case Cue::kBatteryCritical:
-      return 7;
+    case Cue::kVerbosity: return 5;
+    case Cue::kBatteryLow: return 3;
+    case Cue::kBatteryCritical: return 7;
     case Cue::kLastStep:
-    case Cue::kBlind:
-      return 6;
-    case Cue::kCameraLost:
-      return 7;
+    case Cue::kBlind: return 6;
+    case Cue::kCameraLost: return 7;
     case Cue::kDropWarning:
-    case Cue::kDropAhead:
-      return 8;
+    case Cue::kDropAhead: return 8;
   }
   return 0;
 }
@@ -204,15 +170,9 @@ std::vector<std::string> where_clips(const CueEvent& e) {
   std::vector<std::string> c;
   switch (e.kind) {
     case StairKind::kAscending:
-    case StairKind::kDescending:
-      c = {up ? "stairs_up" : "stairs_down"};
-      break;
-    case StairKind::kSingleStep:
-      c = {up ? "step_up" : "step_down"};
-      break;
-    case StairKind::kCurb:
-      c = {up ? "curb_up" : "curb_down"};
-      break;
+    case StairKind::kDescending: c = {up ? "stairs_up" : "stairs_down"}; break;
+    case StairKind::kSingleStep: c = {up ? "step_up" : "step_down"}; break;
+    case StairKind::kCurb: c = {up ? "curb_up" : "curb_down"}; break;
     default:
       if (sayable(e.number)) return {number_clip(e.number), "steps_left"};
       return {"no_stairs"};
@@ -227,8 +187,7 @@ namespace {
 // "blind", which says what it means); nullptr for the others.
 const char* own_clip(Cue c) {
   switch (c) {
-    case Cue::kBlind:
-      return "cannot_see";
+    case Cue::kBlind: return "cannot_see";
     case Cue::kReady:
     case Cue::kCameraLost:
     case Cue::kCameraBack:
@@ -241,10 +200,8 @@ const char* own_clip(Cue c) {
     case Cue::kBatteryCritical:
     case Cue::kSlow:
     case Cue::kMuted:
-    case Cue::kUnmuted:
-      return to_string(c);
-    default:
-      return nullptr;
+    case Cue::kUnmuted: return to_string(c);
+    default: return nullptr;
   }
 }
 }  // namespace
@@ -284,12 +241,8 @@ std::vector<std::string> clips_for(const CueEvent& e) {
     case Cue::kStepsLeft:
       if (sayable(e.number)) c = {number_clip(e.number), "steps_left"};
       break;
-    case Cue::kWhere:
-      c = where_clips(e);
-      break;
-    case Cue::kVerbosity:
-      c = {e.number <= 0 ? "quiet" : e.number == 1 ? "normal" : "verbose"};
-      break;
+    case Cue::kWhere: c = where_clips(e); break;
+    case Cue::kVerbosity: c = {e.number <= 0 ? "quiet" : e.number == 1 ? "normal" : "verbose"}; break;
     default:  // own_clip's
       break;
     case Cue::kDropAhead:

@@ -60,10 +60,8 @@ bool CuePolicy::allowed(Cue c) const {
     case Cue::kWhere:  // the answers to the button
     case Cue::kMuted:
     case Cue::kUnmuted:
-    case Cue::kVerbosity:
-      return true;
-    default:
-      return false;
+    case Cue::kVerbosity: return true;
+    default: return false;
   }
 }
 
@@ -83,14 +81,10 @@ bool CuePolicy::rate_ok(Cue c, double t) const {
     case Cue::kWhere:  // asked for
     case Cue::kMuted:
     case Cue::kUnmuted:
-    case Cue::kVerbosity:
-      return true;
-    case Cue::kTick:
-      return t - last >= cfg_.min_tick_interval;
-    case Cue::kBlind:
-      return t - last >= cfg_.blind_repeat;
-    default:
-      return t - last >= cfg_.min_cue_interval;
+    case Cue::kVerbosity: return true;
+    case Cue::kTick: return t - last >= cfg_.min_tick_interval;
+    case Cue::kBlind: return t - last >= cfg_.blind_repeat;
+    default: return t - last >= cfg_.min_cue_interval;
   }
 }
 
@@ -426,10 +420,8 @@ void CuePolicy::mute_filter(std::vector<CueEvent>& out, double t) {
                                case Cue::kWhere:
                                case Cue::kMuted:
                                case Cue::kUnmuted:
-                               case Cue::kVerbosity:
-                                 return false;
-                               default:
-                                 return true;
+                               case Cue::kVerbosity: return false;
+                               default: return true;
                              }
                            }),
             out.end());
@@ -460,9 +452,7 @@ void CuePolicy::button_cues(const std::vector<Press>& presses, double t, std::ve
   for (const Press p : presses) {
     CueEvent e;
     switch (p) {
-      case Press::kShort:
-        e = where_event(t);
-        break;
+      case Press::kShort: e = where_event(t); break;
       case Press::kLong:
         if (mute_until_ >= 0.0) {
           mute_until_ = -1.0;

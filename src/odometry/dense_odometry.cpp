@@ -30,18 +30,12 @@ namespace stairguide {
 
 const char* to_string(OdometryStatus s) {
   switch (s) {
-    case OdometryStatus::kOk:
-      return "ok";
-    case OdometryStatus::kFirstFrame:
-      return "first frame";
-    case OdometryStatus::kBadInput:
-      return "frame does not match the configured camera";
-    case OdometryStatus::kTooFewPixels:
-      return "too few valid pixels";
-    case OdometryStatus::kDiverged:
-      return "diverged";
-    case OdometryStatus::kJump:
-      return "jump beyond walking motion";
+    case OdometryStatus::kOk: return "ok";
+    case OdometryStatus::kFirstFrame: return "first frame";
+    case OdometryStatus::kBadInput: return "frame does not match the configured camera";
+    case OdometryStatus::kTooFewPixels: return "too few valid pixels";
+    case OdometryStatus::kDiverged: return "diverged";
+    case OdometryStatus::kJump: return "jump beyond walking motion";
   }
   return "?";
 }

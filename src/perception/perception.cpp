@@ -12,24 +12,15 @@ namespace stairguide {
 
 const char* to_string(RegionClass c) {
   switch (c) {
-    case RegionClass::kUnclassified:
-      return "unclassified";
-    case RegionClass::kFloor:
-      return "floor";
-    case RegionClass::kStepCandidate:
-      return "step_candidate";
-    case RegionClass::kObstacle:
-      return "obstacle";
-    case RegionClass::kVerticalLeft:
-      return "vertical_left";
-    case RegionClass::kVerticalRight:
-      return "vertical_right";
-    case RegionClass::kVerticalFront:
-      return "vertical_front";
-    case RegionClass::kVertical:
-      return "vertical";
-    case RegionClass::kOther:
-      return "other";
+    case RegionClass::kUnclassified: return "unclassified";
+    case RegionClass::kFloor: return "floor";
+    case RegionClass::kStepCandidate: return "step_candidate";
+    case RegionClass::kObstacle: return "obstacle";
+    case RegionClass::kVerticalLeft: return "vertical_left";
+    case RegionClass::kVerticalRight: return "vertical_right";
+    case RegionClass::kVerticalFront: return "vertical_front";
+    case RegionClass::kVertical: return "vertical";
+    case RegionClass::kOther: return "other";
   }
   return "unclassified";
 }
@@ -304,20 +295,15 @@ void Perception::apply_odometry(const OdometryLink& odometry, double timestamp, 
 
 cv::Vec3b region_class_color(RegionClass c) {
   switch (c) {
-    case RegionClass::kFloor:
-      return {0, 200, 0};
-    case RegionClass::kStepCandidate:
-      return {255, 80, 0};
+    case RegionClass::kFloor: return {0, 200, 0};
+    case RegionClass::kStepCandidate: return {255, 80, 0};
     case RegionClass::kObstacle:
-    case RegionClass::kOther:
-      return {0, 0, 230};
+    case RegionClass::kOther: return {0, 0, 230};
     case RegionClass::kVerticalLeft:
     case RegionClass::kVerticalRight:
     case RegionClass::kVerticalFront:
-    case RegionClass::kVertical:
-      return {0, 230, 255};
-    case RegionClass::kUnclassified:
-      return {160, 160, 160};
+    case RegionClass::kVertical: return {0, 230, 255};
+    case RegionClass::kUnclassified: return {160, 160, 160};
   }
   return {160, 160, 160};
 }

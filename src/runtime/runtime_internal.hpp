@@ -84,18 +84,12 @@ class Doorbell {
 enum class State { kStarting, kRunning, kCameraLost, kEnded, kStopped, kFailed };
 inline const char* state_name(State s) {
   switch (s) {
-    case State::kStarting:
-      return "starting";
-    case State::kRunning:
-      return "running";
-    case State::kCameraLost:
-      return "camera lost";
-    case State::kEnded:
-      return "ended";
-    case State::kStopped:
-      return "stopped";
-    case State::kFailed:
-      return "failed";
+    case State::kStarting: return "starting";
+    case State::kRunning: return "running";
+    case State::kCameraLost: return "camera lost";
+    case State::kEnded: return "ended";
+    case State::kStopped: return "stopped";
+    case State::kFailed: return "failed";
   }
   return "?";
 }

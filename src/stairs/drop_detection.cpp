@@ -225,20 +225,13 @@ std::vector<Edge> join_columns(const std::vector<ColumnEdge>& cols, float spacin
 
 const char* to_string(DropVerdict v) {
   switch (v) {
-    case DropVerdict::kDetected:
-      return "drop";
-    case DropVerdict::kDisabled:
-      return "disabled";
-    case DropVerdict::kNoFloor:
-      return "no floor";
-    case DropVerdict::kNoEdge:
-      return "no edge";
-    case DropVerdict::kNoDepthSeen:
-      return "nothing seen below the edge";
-    case DropVerdict::kTooNarrow:
-      return "edge too short";
-    case DropVerdict::kTooFar:
-      return "too far";
+    case DropVerdict::kDetected: return "drop";
+    case DropVerdict::kDisabled: return "disabled";
+    case DropVerdict::kNoFloor: return "no floor";
+    case DropVerdict::kNoEdge: return "no edge";
+    case DropVerdict::kNoDepthSeen: return "nothing seen below the edge";
+    case DropVerdict::kTooNarrow: return "edge too short";
+    case DropVerdict::kTooFar: return "too far";
   }
   return "?";
 }

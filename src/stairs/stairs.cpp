@@ -7,44 +7,28 @@ namespace stairguide {
 
 const char* to_string(StairAxesMethod m) {
   switch (m) {
-    case StairAxesMethod::kNone:
-      return "none";
-    case StairAxesMethod::kManhattan:
-      return "manhattan";
-    case StairAxesMethod::kPca:
-      return "pca";
+    case StairAxesMethod::kNone: return "none";
+    case StairAxesMethod::kManhattan: return "manhattan";
+    case StairAxesMethod::kPca: return "pca";
   }
   return "none";
 }
 
 const char* to_string(StairVerdict v) {
   switch (v) {
-    case StairVerdict::kDetected:
-      return "detected";
-    case StairVerdict::kNoFloor:
-      return "no floor";
-    case StairVerdict::kFloorDoubtful:
-      return "floor doubtful (a lower level is nearer the user)";
-    case StairVerdict::kNoCandidates:
-      return "no step candidates";
-    case StairVerdict::kNoFirstStep:
-      return "no first step connected to the floor";
-    case StairVerdict::kObstacle:
-      return "single level too small for a step (obstacle)";
-    case StairVerdict::kRiserOutOfRange:
-      return "rise not a step's (under 5 or over 25 cm)";
-    case StairVerdict::kTreadTooShort:
-      return "tread too shallow to hold a foot";
-    case StairVerdict::kBlondelOutOfRange:
-      return "2R+T outside the building code";
-    case StairVerdict::kTooNarrow:
-      return "too narrow to walk";
-    case StairVerdict::kInconsistentEdges:
-      return "step edges not evenly spaced";
-    case StairVerdict::kStackedLevels:
-      return "a level stands on the one below it (an object on a surface)";
-    case StairVerdict::kTreadTooLong:
-      return "levels farther apart than a stride (not one flight)";
+    case StairVerdict::kDetected: return "detected";
+    case StairVerdict::kNoFloor: return "no floor";
+    case StairVerdict::kFloorDoubtful: return "floor doubtful (a lower level is nearer the user)";
+    case StairVerdict::kNoCandidates: return "no step candidates";
+    case StairVerdict::kNoFirstStep: return "no first step connected to the floor";
+    case StairVerdict::kObstacle: return "single level too small for a step (obstacle)";
+    case StairVerdict::kRiserOutOfRange: return "rise not a step's (under 5 or over 25 cm)";
+    case StairVerdict::kTreadTooShort: return "tread too shallow to hold a foot";
+    case StairVerdict::kBlondelOutOfRange: return "2R+T outside the building code";
+    case StairVerdict::kTooNarrow: return "too narrow to walk";
+    case StairVerdict::kInconsistentEdges: return "step edges not evenly spaced";
+    case StairVerdict::kStackedLevels: return "a level stands on the one below it (an object on a surface)";
+    case StairVerdict::kTreadTooLong: return "levels farther apart than a stride (not one flight)";
   }
   return "unknown";
 }

@@ -47,12 +47,9 @@ std::uint64_t mix_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
 
 Material floor_material(Rng& rng) {
   switch (rng.integer(0, 2)) {
-    case 0:
-      return mat(rng, V3(0.55f, 0.60f, 0.65f), Texture::kTiles, 0.35f);
-    case 1:
-      return mat(rng, V3(0.35f, 0.30f, 0.45f), Texture::kCarpet, 0.45f, 0.004f);
-    default:
-      return mat(rng, V3(0.50f, 0.52f, 0.52f), Texture::kConcrete, 0.4f);
+    case 0: return mat(rng, V3(0.55f, 0.60f, 0.65f), Texture::kTiles, 0.35f);
+    case 1: return mat(rng, V3(0.35f, 0.30f, 0.45f), Texture::kCarpet, 0.45f, 0.004f);
+    default: return mat(rng, V3(0.50f, 0.52f, 0.52f), Texture::kConcrete, 0.4f);
   }
 }
 Material wall_material(Rng& rng) {
@@ -61,14 +58,10 @@ Material wall_material(Rng& rng) {
 }
 Material stair_material(Rng& rng) {
   switch (rng.integer(0, 3)) {
-    case 0:
-      return mat(rng, V3(0.25f, 0.40f, 0.60f), Texture::kWood, 0.35f, 0.004f);
-    case 1:
-      return mat(rng, V3(0.55f, 0.56f, 0.56f), Texture::kConcrete, 0.4f);
-    case 2:
-      return mat(rng, V3(0.50f, 0.55f, 0.60f), Texture::kTiles, 0.3f);
-    default:
-      return mat(rng, V3(0.30f, 0.25f, 0.40f), Texture::kCarpet, 0.45f, 0.004f);
+    case 0: return mat(rng, V3(0.25f, 0.40f, 0.60f), Texture::kWood, 0.35f, 0.004f);
+    case 1: return mat(rng, V3(0.55f, 0.56f, 0.56f), Texture::kConcrete, 0.4f);
+    case 2: return mat(rng, V3(0.50f, 0.55f, 0.60f), Texture::kTiles, 0.3f);
+    default: return mat(rng, V3(0.30f, 0.25f, 0.40f), Texture::kCarpet, 0.45f, 0.004f);
   }
 }
 Material wood_material(Rng& rng) { return mat(rng, V3(0.20f, 0.35f, 0.55f), Texture::kWood, 0.35f, 0.004f); }

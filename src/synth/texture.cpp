@@ -113,8 +113,7 @@ std::vector<float> make(Texture t) {
           img[static_cast<std::size_t>(y * N + x)] += 0.6f * std::sin(kTwoPi * static_cast<float>(x) / 4.f) *
                                                       std::sin(kTwoPi * static_cast<float>(y) / 4.f);
       break;
-    case Texture::kCount:
-      break;
+    case Texture::kCount: break;
   }
   normalise(img);
   return img;

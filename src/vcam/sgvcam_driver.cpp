@@ -182,22 +182,16 @@ class VcamStream : public oni::driver::StreamBase {
 
   OniStatus getProperty(int id, void* data, int* size) override {
     switch (id) {
-      case ONI_STREAM_PROPERTY_VIDEO_MODE:
-        return put(mode_, data, size);
-      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV:
-        return put(hfov_, data, size);
-      case ONI_STREAM_PROPERTY_VERTICAL_FOV:
-        return put(vfov_, data, size);
-      case ONI_STREAM_PROPERTY_MIRRORING:
-        return put(OniBool(FALSE), data, size);
-      case ONI_STREAM_PROPERTY_STRIDE:
-        return put(mode_.resolutionX * bpp(), data, size);
+      case ONI_STREAM_PROPERTY_VIDEO_MODE: return put(mode_, data, size);
+      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV: return put(hfov_, data, size);
+      case ONI_STREAM_PROPERTY_VERTICAL_FOV: return put(vfov_, data, size);
+      case ONI_STREAM_PROPERTY_MIRRORING: return put(OniBool(FALSE), data, size);
+      case ONI_STREAM_PROPERTY_STRIDE: return put(mode_.resolutionX * bpp(), data, size);
       case ONI_STREAM_PROPERTY_MAX_VALUE:
         return type_ == ONI_SENSOR_DEPTH ? put(int(10000), data, size) : ONI_STATUS_NOT_SUPPORTED;
       case ONI_STREAM_PROPERTY_MIN_VALUE:
         return type_ == ONI_SENSOR_DEPTH ? put(int(0), data, size) : ONI_STATUS_NOT_SUPPORTED;
-      default:
-        return ONI_STATUS_NOT_SUPPORTED;
+      default: return ONI_STATUS_NOT_SUPPORTED;
     }
   }
 

@@ -100,15 +100,12 @@ struct StairResult {
   int direction() const {
     switch (kind) {
       case StairKind::kAscending:
-      case StairKind::kSingleStep:
-        return 1;
-      case StairKind::kDescending:
-        return -1;
+      case StairKind::kSingleStep: return 1;
+      case StairKind::kDescending: return -1;
       case StairKind::kCurb:
         if (level_data.size() > 1 && level_data[1].height != 0.f) return level_data[1].height > 0.f ? 1 : -1;
         return 0;
-      default:
-        return 0;
+      default: return 0;
     }
   }
 

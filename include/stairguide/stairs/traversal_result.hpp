@@ -54,16 +54,11 @@ enum class TraversalState {
 /// "searching", "stair_ahead", "on_stairs", "last_step", "arrived".
 inline const char* to_string(TraversalState s) {
   switch (s) {
-    case TraversalState::kSearching:
-      return "searching";
-    case TraversalState::kStairAhead:
-      return "stair_ahead";
-    case TraversalState::kOnStairs:
-      return "on_stairs";
-    case TraversalState::kLastStep:
-      return "last_step";
-    case TraversalState::kArrived:
-      return "arrived";
+    case TraversalState::kSearching: return "searching";
+    case TraversalState::kStairAhead: return "stair_ahead";
+    case TraversalState::kOnStairs: return "on_stairs";
+    case TraversalState::kLastStep: return "last_step";
+    case TraversalState::kArrived: return "arrived";
   }
   return "searching";
 }
