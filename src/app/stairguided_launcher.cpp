@@ -14,20 +14,15 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "stop_signals.hpp"
+
 #ifndef STAIRGUIDED_CORE
 #define STAIRGUIDED_CORE "/usr/libexec/stairguide/stairguided-core"
 #endif
 
 namespace {
 
-void block_stop_signals(int, char**, char**) {
-  sigset_t sigs;
-  sigemptyset(&sigs);
-  sigaddset(&sigs, SIGTERM);
-  sigaddset(&sigs, SIGINT);
-  sigaddset(&sigs, SIGHUP);
-  sigprocmask(SIG_BLOCK, &sigs, nullptr);
-}
+using stairguide_app::block_stop_signals;
 // Before main and the C++ runtime's constructors.
 __attribute__((section(".preinit_array"), used)) void (*const block_early)(int, char**,
                                                                            char**) = block_stop_signals;

@@ -22,6 +22,8 @@
 #include "stairguide/runtime/notifier.hpp"
 #include "stairguide/runtime/runtime.hpp"
 
+#include "stop_signals.hpp"
+
 namespace {
 
 using namespace stairguide;
@@ -137,14 +139,7 @@ bool parse_args(int argc, char** argv, Args& a, std::string& err) {
 // shared libraries load waits for the signal thread instead of killing the process (exit 143).
 // Run directly, this binary blocks them from its .preinit_array, before the libraries'
 // constructors though after the dynamic loader's relocations (most of the start-up).
-void block_stop_signals(int, char**, char**) {
-  sigset_t sigs;
-  sigemptyset(&sigs);
-  sigaddset(&sigs, SIGTERM);
-  sigaddset(&sigs, SIGINT);
-  sigaddset(&sigs, SIGHUP);
-  pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
-}
+using stairguide_app::block_stop_signals;
 __attribute__((section(".preinit_array"),
                used)) void (*const block_stop_signals_early)(int, char**, char**) = block_stop_signals;
 
@@ -190,11 +185,7 @@ int daemon_main(int argc, char** argv) {
   // Signals are taken synchronously by one thread (sigtimedwait), never by a handler. Blocked
   // first thing, so a SIGHUP or SIGTERM during start-up waits instead of killing the process;
   // every thread started later inherits the mask.
-  sigset_t sigs;
-  sigemptyset(&sigs);
-  sigaddset(&sigs, SIGTERM);
-  sigaddset(&sigs, SIGINT);
-  sigaddset(&sigs, SIGHUP);
+  const sigset_t sigs = stairguide_app::stop_and_reload_signals();
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
