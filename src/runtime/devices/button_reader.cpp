@@ -7,10 +7,11 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <gpiod.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+
+#include "gpio_chip_line.hpp"
 
 namespace stairguide::runtime::devices {
 
@@ -25,25 +26,16 @@ double steady_seconds() {
 
 // ---------------------------------------------------------------- libgpiod line
 
-struct GpiodButtonLine::Impl {
-  gpiod::chip chip;
-  gpiod::line line;
-};
+struct GpiodButtonLine::Impl : detail::GpioChipLine {};
 
 GpiodButtonLine::GpiodButtonLine(const std::string& chip, int line, bool active_low,
                                  const std::string& consumer)
     : impl_(std::make_unique<Impl>()) {
   desc_ = "gpiod:" + chip + ":" + std::to_string(line);
-  const std::string what = "button: GPIO chip '" + chip + "' line " + std::to_string(line) + ": ";
-  try {
-    impl_->chip.open(chip, gpiod::chip::OPEN_LOOKUP);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(what + "cannot open the chip (" + e.what() + ")");
-  }
+  impl_->open("button", chip, line);
   std::bitset<32> flags;
   if (active_low) flags = gpiod::line_request::FLAG_ACTIVE_LOW;
   try {
-    impl_->line = impl_->chip.get_line(static_cast<unsigned>(line));
     try {
       // A button to ground wants the line pulled up; kernels before 5.5 cannot set the bias
       // (an external pull-up then does it), so the request is tried again without it.
@@ -54,17 +46,12 @@ GpiodButtonLine::GpiodButtonLine(const std::string& chip, int line, bool active_
       impl_->line.request({consumer, gpiod::line_request::EVENT_BOTH_EDGES, flags});
     }
   } catch (const std::exception& e) {
-    throw std::runtime_error(what + "cannot request the line for edge events (" + e.what() + ")");
+    throw std::runtime_error(detail::GpioChipLine::what("button", chip, line) +
+                             "cannot request the line for edge events (" + e.what() + ")");
   }
 }
 
-GpiodButtonLine::~GpiodButtonLine() {
-  try {
-    if (impl_->line) impl_->line.release();
-  } catch (const std::exception&) {
-    // released with the chip anyway
-  }
-}
+GpiodButtonLine::~GpiodButtonLine() { impl_->release(); }
 
 void GpiodButtonLine::wait(std::chrono::milliseconds timeout, std::vector<ButtonEdge>& out) {
   try {

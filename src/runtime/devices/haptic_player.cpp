@@ -3,9 +3,10 @@
 #include <pthread.h>
 #include <sched.h>
 
-#include <gpiod.hpp>
 #include <stdexcept>
 #include <system_error>
+
+#include "gpio_chip_line.hpp"
 
 namespace stairguide::runtime::devices {
 
@@ -15,37 +16,26 @@ using feedback::Pulse;
 
 // ---------------------------------------------------------------- lines
 
-struct GpiodLine::Impl {
-  gpiod::chip chip;
-  gpiod::line line;
-};
+struct GpiodLine::Impl : detail::GpioChipLine {};
 
 GpiodLine::GpiodLine(const std::string& chip, int line, const std::string& consumer)
     : impl_(std::make_unique<Impl>()) {
   desc_ = "gpiod:" + chip + ":" + std::to_string(line);
-  const std::string what = "haptic: GPIO chip '" + chip + "' line " + std::to_string(line) + ": ";
+  impl_->open("haptic", chip, line);
   try {
-    impl_->chip.open(chip, gpiod::chip::OPEN_LOOKUP);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(what + "cannot open the chip (" + e.what() + ")");
-  }
-  try {
-    impl_->line = impl_->chip.get_line(static_cast<unsigned>(line));
     impl_->line.request({consumer, gpiod::line_request::DIRECTION_OUTPUT, 0}, 0);
   } catch (const std::exception& e) {
-    throw std::runtime_error(what + "cannot request the line as an output (" + e.what() + ")");
+    throw std::runtime_error(detail::GpioChipLine::what("haptic", chip, line) +
+                             "cannot request the line as an output (" + e.what() + ")");
   }
 }
 
 GpiodLine::~GpiodLine() {
   try {
-    if (impl_->line) {
-      impl_->line.set_value(0);
-      impl_->line.release();
-    }
+    if (impl_->line) impl_->line.set_value(0);  // the buzzer is left off
   } catch (const std::exception&) {
-    // the line is released with the chip anyway
   }
+  impl_->release();
 }
 
 void GpiodLine::set(bool on) {
