@@ -235,6 +235,21 @@ TEST_F(DaemonE2E, SighupAppliesAValidConfigAndRejectsAnInvalidOne) {
   EXPECT_EQ(d.wait_exit(5.0), 0);
 }
 
+// The daemon's per-frame lines ("frame=..."), each cut down to `keys` ("k=v " in that order): the
+// decisions two runs are compared by.
+static std::vector<std::string> decisions(const std::vector<std::string>& lines,
+                                          std::initializer_list<const char*> keys) {
+  std::vector<std::string> out;
+  for (const auto& line : lines) {
+    if (line.rfind("frame=", 0) != 0) continue;
+    auto kv = parse_kv(line);
+    std::string keep;
+    for (const char* k : keys) keep += std::string(k) + "=" + kv[k] + " ";
+    out.push_back(keep);
+  }
+  return out;
+}
+
 // Issue 41: 50 SIGHUPs of an unchanged config in a second, before the flight, delayed "first step"
 // by 25 frames and said "6 steps left" where it was 5. Through the whole daemon on a climb of 8 steps
 // (one thread, paced as the camera would give the frames, so every frame's decision can be
@@ -262,17 +277,8 @@ TEST_F(DaemonE2E, ABurstOfSighupsOfAnUnchangedConfigLeavesEveryDecisionAsWithout
       EXPECT_NE(err.find("unchanged; the running config and its state are kept"), std::string::npos) << err;
       EXPECT_EQ(err.find("config reloaded from"), std::string::npos) << err;
     }
-    std::vector<std::string> out;
-    for (const auto& line : lines) {
-      if (line.rfind("frame=", 0) != 0) continue;
-      auto kv = parse_kv(line);
-      std::string keep;
-      for (const char* k :
-           {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left", "known", "cue"})
-        keep += std::string(k) + "=" + kv[k] + " ";
-      out.push_back(keep);
-    }
-    return out;
+    return decisions(lines, {"frame", "odom", "perception", "cfg", "manhattan", "traversal", "step", "left",
+                             "known", "cue"});
   };
   const auto calm = run(false), storm = run(true);
   ASSERT_GT(calm.size(), 300u);
@@ -314,17 +320,8 @@ TEST_F(DaemonE2E, ADatasetWhoseClockJumpsBackIsWarnedAndCountsAsWithAGoodClock) 
     std::vector<std::string> lines;
     EXPECT_EQ(d.wait_exit(300.0, &lines), 0) << d.stderr_text();
     if (err) *err = d.stderr_text();
-    std::vector<std::string> out;
-    for (const auto& line : lines) {
-      if (line.rfind("frame=", 0) != 0) continue;
-      auto kv = parse_kv(line);
-      std::string keep;
-      for (const char* k :
-           {"frame", "odom", "perception", "manhattan", "traversal", "step", "left", "known", "cue"})
-        keep += std::string(k) + "=" + kv[k] + " ";
-      out.push_back(keep);
-    }
-    return out;
+    return decisions(
+        lines, {"frame", "odom", "perception", "manhattan", "traversal", "step", "left", "known", "cue"});
   };
   const auto good = run(write("clock_good", 1e9), "clock_good", nullptr);
   std::string err;

@@ -168,6 +168,17 @@ TEST(EdgeCompass, SyntheticFloorJoints) {
   EXPECT_LT(err, 1.f);
 }
 
+// The real 7-Scenes kitchen of the shared data, or null and why not (the tests are skipped).
+static std::unique_ptr<DatasetSource> open_kitchen(std::string& why) {
+  const std::string kitchen = std::string(STAIRGUIDE_SHARED_DATA) + "/7scenes-redkitchen-0000-0299";
+  try {
+    return std::make_unique<DatasetSource>(kitchen);
+  } catch (const std::exception& e) {
+    why = std::string("no 7-Scenes kitchen under ") + STAIRGUIDE_SHARED_DATA + ": " + e.what();
+    return nullptr;
+  }
+}
+
 // Real edges (the 7-Scenes kitchen: cupboards, worktop, a table turned 17 degrees against the
 // room, chairs, the floor; Kinect colour, not registered to depth, which shifts the edges by a few
 // pixels and may turn the colour camera by a degree against the depth camera). On every view where
@@ -175,13 +186,9 @@ TEST(EdgeCompass, SyntheticFloorJoints) {
 // compass agrees with it. (With Sobel's kernel instead of Scharr's, 9 of these views followed the
 // table's edges, 17.5 degrees off: the bias towards the image axes tipped the balance.)
 TEST(EdgeCompassRealData, KitchenEdgesAgreeWithTheWalls) {
-  const std::string kitchen = std::string(STAIRGUIDE_SHARED_DATA) + "/7scenes-redkitchen-0000-0299";
-  std::unique_ptr<DatasetSource> src;
-  try {
-    src = std::make_unique<DatasetSource>(kitchen);
-  } catch (const std::exception& e) {
-    GTEST_SKIP() << "no 7-Scenes kitchen under " << STAIRGUIDE_SHARED_DATA << ": " << e.what();
-  }
+  std::string why;
+  const std::unique_ptr<DatasetSource> src = open_kitchen(why);
+  if (!src) GTEST_SKIP() << why;
   EdgeCompass compass;
   RgbdFrame f;
   int compared = 0;
@@ -278,13 +285,9 @@ TEST(EdgeCompass, FurnitureEdgesAreNoFloorLines) {
 // 29 of the 32 views, 233 within 2 deg of the planes' frame, 253 within 3, the worst 4.37 deg: a
 // line alone makes no frame, it only confirms a wall that agrees with it (ManhattanFrame.FloorLine*).
 TEST(EdgeCompassRealData, KitchenFloorLinesAgreeWithTheWalls) {
-  const std::string kitchen = std::string(STAIRGUIDE_SHARED_DATA) + "/7scenes-redkitchen-0000-0299";
-  std::unique_ptr<DatasetSource> src;
-  try {
-    src = std::make_unique<DatasetSource>(kitchen);
-  } catch (const std::exception& e) {
-    GTEST_SKIP() << "no 7-Scenes kitchen under " << STAIRGUIDE_SHARED_DATA << ": " << e.what();
-  }
+  std::string why;
+  const std::unique_ptr<DatasetSource> src = open_kitchen(why);
+  if (!src) GTEST_SKIP() << why;
   EdgeCompass compass;
   RgbdFrame f;
   int views = 0, lines = 0, within2 = 0;

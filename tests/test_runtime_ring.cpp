@@ -192,6 +192,36 @@ TEST(SpscRingStress, MoveOnlyPayloadsArriveIntact) {
   EXPECT_EQ(bad, 0u);
 }
 
+namespace {
+
+// What a consumer received from a producer that sets `done` when it has sent everything.
+struct Received {
+  std::uint64_t items = 0, regressions = 0;  // regressions: values not above the one received before
+  std::uint64_t last = 0;                    // the last value received
+};
+
+// Takes with `take(value)` (false: nothing there) until the producer is done and nothing is left.
+template <class Take>
+Received receive_until_done(const std::atomic<bool>& done, Take take) {
+  Received got;
+  for (;;) {
+    const bool finished = done.load(std::memory_order_acquire);
+    std::uint64_t v = 0;
+    if (take(v)) {
+      if (got.items > 0 && v <= got.last) ++got.regressions;
+      got.last = v;
+      ++got.items;
+    } else if (finished) {
+      break;
+    } else {
+      std::this_thread::yield();
+    }
+  }
+  return got;
+}
+
+}  // namespace
+
 // Skip-to-newest and drop-when-full under contention: values only increase, and
 // received + skipped + dropped == produced.
 TEST(SpscRingStress, PopNewestAndDropsAccountForEveryItem) {
@@ -201,23 +231,9 @@ TEST(SpscRingStress, PopNewestAndDropsAccountForEveryItem) {
     for (std::uint64_t i = 0; i < kStressItems; ++i) r.push_or_drop(std::uint64_t{i});
     done.store(true, std::memory_order_release);
   });
-  std::uint64_t received = 0, regressions = 0, last = 0;
-  bool first = true;
-  for (;;) {
-    const bool finished = done.load(std::memory_order_acquire);
-    std::uint64_t v = 0;
-    if (r.pop_newest(v) >= 0) {
-      if (!first && v <= last) ++regressions;
-      first = false;
-      last = v;
-      ++received;
-    } else if (finished) {
-      break;
-    } else {
-      std::this_thread::yield();
-    }
-  }
+  const Received got = receive_until_done(done, [&](std::uint64_t& v) { return r.pop_newest(v) >= 0; });
   producer.join();
+  const std::uint64_t received = got.items, regressions = got.regressions;
   EXPECT_EQ(regressions, 0u);
   EXPECT_EQ(received + r.skipped() + r.dropped(), kStressItems);
   EXPECT_GT(received, 0u);
@@ -230,25 +246,16 @@ TEST(NewestSlotStress, ConsumerSeesIncreasingValuesAndEveryItemIsAccounted) {
     for (std::uint64_t i = 0; i < kStressItems; ++i) s.publish(std::make_unique<std::uint64_t>(i));
     done.store(true, std::memory_order_release);
   });
-  std::uint64_t received = 0, regressions = 0, last = 0;
-  bool first = true;
-  for (;;) {
-    const bool finished = done.load(std::memory_order_acquire);
+  const Received got = receive_until_done(done, [&](std::uint64_t& v) {
     std::unique_ptr<std::uint64_t> p;
-    if (s.take(p)) {
-      if (!first && *p <= last) ++regressions;
-      first = false;
-      last = *p;
-      ++received;
-    } else if (finished) {
-      break;
-    } else {
-      std::this_thread::yield();
-    }
-  }
+    if (!s.take(p)) return false;
+    v = *p;
+    return true;
+  });
   producer.join();
+  const std::uint64_t received = got.items, regressions = got.regressions;
   EXPECT_EQ(regressions, 0u);
   EXPECT_EQ(received, s.taken());
   EXPECT_EQ(s.taken() + s.overwritten(), kStressItems);
-  EXPECT_EQ(last, kStressItems - 1);
+  EXPECT_EQ(got.last, kStressItems - 1);
 }

@@ -23,7 +23,9 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli/command.hpp"
@@ -479,6 +481,10 @@ bool find_num(const std::string& line, const char* key, double& v) {
   v = std::strtod(line.c_str() + p + k.size(), &end);
   return end != line.c_str() + p + k.size();
 }
+// Each key's number where the line has it (the others keep their value).
+void find_nums(const std::string& line, std::initializer_list<std::pair<const char*, double*>> keys) {
+  for (const auto& [key, v] : keys) find_num(line, key, *v);
+}
 std::string find_str(const std::string& line, const char* key) {
   const std::string k = std::string("\"") + key + "\": \"";
   const std::size_t p = line.find(k);
@@ -516,13 +522,13 @@ int eval_traversal(Context& ctx) {
       if (!find_num(line, "truth", v) || v == 0) continue;
       ++with_truth;
       double step = 0, t_step = 0, t_steps = 0, t_tread = 0, t_along = 0, known = 0, last_known = 0;
-      find_num(line, "step", step);
-      find_num(line, "t_step", t_step);
-      find_num(line, "t_steps", t_steps);
-      find_num(line, "t_tread_m", t_tread);
-      find_num(line, "t_along", t_along);
-      find_num(line, "known", known);
-      find_num(line, "last_known", last_known);
+      find_nums(line, {{"step", &step},
+                       {"t_step", &t_step},
+                       {"t_steps", &t_steps},
+                       {"t_tread_m", &t_tread},
+                       {"t_along", &t_along},
+                       {"known", &known},
+                       {"last_known", &last_known}});
       const int N = static_cast<int>(t_steps);
       s.steps = N;
       if (gap_done.size() != static_cast<std::size_t>(N + 1))
@@ -550,13 +556,13 @@ int eval_traversal(Context& ctx) {
         }
       }
       double det = 0, in_view = 0, dr = 0, dt = 0, r = 0, t = 0, tr = 0;
-      find_num(line, "detected", det);
-      find_num(line, "in_view", in_view);
-      find_num(line, "det_riser_m", dr);
-      find_num(line, "det_tread_m", dt);
-      find_num(line, "riser_m", r);
-      find_num(line, "tread_m", t);
-      find_num(line, "t_riser_m", tr);
+      find_nums(line, {{"detected", &det},
+                       {"in_view", &in_view},
+                       {"det_riser_m", &dr},
+                       {"det_tread_m", &dt},
+                       {"riser_m", &r},
+                       {"tread_m", &t},
+                       {"t_riser_m", &tr}});
       if (det > 0 && in_view > 0 && dr > 0 && dt > 0) {
         s.sr += std::fabs(dr - tr), s.st += std::fabs(dt - t_tread), s.fr += std::fabs(r - tr),
             s.ft += std::fabs(t - t_tread);
