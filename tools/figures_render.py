@@ -4,7 +4,9 @@
 usage: tools/figures_render.py FIGURES_DIR OUT.md
 
 Each figure gets a table: what the value measures, the goal it is held to (where there is one)
-and the value measured, followed by every other number of its JSON. Standard library only.
+and the value measured; an evaluation's breakdowns follow as tables of their own (per preset, per
+kind, the verdicts, the confusion of kinds, the drop-offs), then every other number of its JSON.
+Standard library only.
 """
 import json
 import os
@@ -18,6 +20,18 @@ DROP_STAGE_ROWS = [
     ("drop_cpu_share", "drop stage / ours (median CPU time)", "", "ratio"),
 ]
 
+
+def perception_rows(ms_goal):
+    """bench perception's rows: ours against the PCL reference, then the drop stage on its own."""
+    return [("ours_median_ms", "ours, median per frame (wall)", ms_goal, "ms"),
+            ("ours_cpu_median_ms", "ours, median per frame (CPU)", ms_goal, "ms"),
+            ("ours_p95_ms", "ours, 95th percentile (wall)", "", "ms"),
+            ("reference_median_ms", "PCL reference, median per frame (wall)", "", "ms"),
+            ("reference_cpu_median_ms", "PCL reference, median per frame (CPU)", "", "ms"),
+            ("ratio", "reference / ours (median wall time)", ">= 8x", "x"),
+            ("cpu_ratio", "reference / ours (median CPU time)", "", "x")] + DROP_STAGE_ROWS
+
+
 # name: (title, what the run measures, [(JSON key, what it means, goal, unit)])
 # unit: "ms", "m->cm" (metres shown in cm), "m->mm", "ratio" (a share shown as %), "x", "" (as is)
 FIGURES = [
@@ -25,22 +39,10 @@ FIGURES = [
      "Plane segmentation, floor, Manhattan frame and classification on 32 synthetic 640x480 frames, "
      "one thread; the reference is the paper's PCL pipeline (voxel grid, normals, region growing, "
      "RANSAC, clusters) on the same frames in the same process, taking turns frame by frame.",
-     [("ours_median_ms", "ours, median per frame (wall)", "", "ms"),
-      ("ours_cpu_median_ms", "ours, median per frame (CPU)", "", "ms"),
-      ("ours_p95_ms", "ours, 95th percentile (wall)", "", "ms"),
-      ("reference_median_ms", "PCL reference, median per frame (wall)", "", "ms"),
-      ("reference_cpu_median_ms", "PCL reference, median per frame (CPU)", "", "ms"),
-      ("ratio", "reference / ours (median wall time)", ">= 8x", "x"),
-      ("cpu_ratio", "reference / ours (median CPU time)", "", "x")] + DROP_STAGE_ROWS),
+     perception_rows("")),
     ("bench-perception-kitchen", "Perception speed, real Kinect frames",
      "The same benchmark on 32 frames of the real 7-Scenes kitchen (../shared/data).",
-     [("ours_median_ms", "ours, median per frame (wall)", "<= 8 ms", "ms"),
-      ("ours_cpu_median_ms", "ours, median per frame (CPU)", "<= 8 ms", "ms"),
-      ("ours_p95_ms", "ours, 95th percentile (wall)", "", "ms"),
-      ("reference_median_ms", "PCL reference, median per frame (wall)", "", "ms"),
-      ("reference_cpu_median_ms", "PCL reference, median per frame (CPU)", "", "ms"),
-      ("ratio", "reference / ours (median wall time)", ">= 8x", "x"),
-      ("cpu_ratio", "reference / ours (median CPU time)", "", "x")] + DROP_STAGE_ROWS),
+     perception_rows("<= 8 ms")),
     ("bench-stairs", "Stair detection and modelling speed",
      "The stairs stage (detection + modelling) per frame on the synthetic presets, perception run "
      "beforehand and not timed; the reference is the paper's stair stage configuration.",
@@ -186,6 +188,72 @@ def scalars(obj, prefix=""):
     return out
 
 
+# An evaluation's breakdowns (stairguide eval --json), each shown as a table of its own rather
+# than among "every value": per preset or labelled set, per kind of staircase, why each frame was
+# decided as it was, what was taken for what, and the drop-offs.
+BREAKDOWNS = ("by_scene", "by_kind", "verdicts", "confusion", "drops")
+DETECTION_COLUMNS = [("frames", "frames", ""), ("tp", "TP", ""), ("fp", "FP", ""), ("fn", "FN", ""),
+                     ("tn", "TN", ""), ("recall_fully_visible", "recall, >= 2 steps", "ratio"),
+                     ("riser_err_mean_m", "riser err", "m->cm"), ("tread_err_mean_m", "tread err", "m->cm")]
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(r) + " |" for r in rows]
+    return out
+
+
+def detection_table(title, groups):
+    """One row per preset (or kind): the detection counts and errors."""
+    def cell(g, key, unit):
+        # A share or a mean over no frames is not a figure: shown as "-".
+        if key == "recall_fully_visible" and not g.get("fully_visible_frames"):
+            return "-"
+        if key.endswith("_mean_m") and not g.get(key.replace("_mean_m", "_n")):
+            return "-"
+        return show(g.get(key), unit)
+    rows = [[f"`{name}`"] + [cell(g, k, u) for k, _, u in DETECTION_COLUMNS] for name, g in sorted(groups.items())]
+    return ["", f"**{title}**", ""] + table([""] + [c for _, c, _ in DETECTION_COLUMNS], rows)
+
+
+def verdict_table(verdicts):
+    """Why each frame was decided as it was: the detector's verdict, by outcome (TP, FP, FN, TN)."""
+    outcomes = [o for o in ("TP", "FP", "FN", "TN") if o in verdicts]
+    names = sorted({v for o in outcomes for v in verdicts[o]})
+    rows = [[v] + [str(verdicts[o].get(v, 0)) for o in outcomes] for v in names]
+    return ["", "**Why each frame was decided so (the verdicts)**", ""] + table(["verdict"] + outcomes, rows)
+
+
+def confusion_table(confusion):
+    """Rows: the true kind; columns: the kind reported."""
+    said = sorted({k for row in confusion.values() for k in row})
+    rows = [[f"{truth}"] + [str(confusion[truth].get(k, 0)) for k in said] for truth in sorted(confusion)]
+    return ["", "**Kind reported (columns) for each true kind (rows)**", ""] + table(["truth"] + said, rows)
+
+
+def drops_line(drops):
+    """The drop-off stage on the same views: told near a drop, silent elsewhere."""
+    near, told = drops.get("near", 0), drops.get("near_told", 0)
+    none, none_told = drops.get("none", 0), drops.get("none_told", 0)
+    return ["", f"**Drop-offs on the same views:** told on {told} of {near} frames with a drop within "
+            f"{show(drops.get('near_m'), '')} m; said on {none_told} of {none} frames with no drop and no descent."]
+
+
+def breakdowns(result):
+    out = []
+    if isinstance(result.get("by_scene"), dict):
+        out += detection_table("Per preset", result["by_scene"])
+    if isinstance(result.get("by_kind"), dict):
+        out += detection_table("Per kind of staircase", result["by_kind"])
+    if isinstance(result.get("verdicts"), dict):
+        out += verdict_table(result["verdicts"])
+    if isinstance(result.get("confusion"), dict):
+        out += confusion_table(result["confusion"])
+    if isinstance(result.get("drops"), dict):
+        out += drops_line(result["drops"])
+    return out
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
@@ -226,7 +294,9 @@ def main():
                 continue
             shown.add(key)
             lines.append(f"| {meaning} | {goal or '-'} | {show(v, unit)} |")
-        rest = [(k, v) for k, v in scalars(result) if k not in shown]
+        lines += breakdowns(result)
+        rest = [(k, v) for k, v in scalars({k: v for k, v in result.items() if k not in BREAKDOWNS})
+                if k not in shown]
         if rest:
             lines += ["", "<details><summary>every value of the JSON</summary>", "",
                       ", ".join(f"`{k}` {show(v, '')}" for k, v in rest), "", "</details>"]
