@@ -22,17 +22,7 @@ PipelineConfig no_sinks() {
 }
 
 PerceptionOutput climbing(int seq, int climbed) {
-  PerceptionOutput p;
-  p.seq = static_cast<std::uint64_t>(seq);
-  p.ran = true;
-  p.floor_found = true;
-  p.state = "ascending";
-  p.traversal.ran = true;
-  p.traversal.state = TraversalState::kOnStairs;
-  p.traversal.kind = StairKind::kAscending;
-  p.traversal.direction = 1;
-  p.traversal.steps_climbed = p.traversal.step_index = climbed;
-  return p;
+  return climbing_output(static_cast<std::uint64_t>(seq), climbed);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "capture_util.hpp"
+#include "stairguide/core/nearest_in_time.hpp"
 #include "stairguide/config/strict_yaml.hpp"
 
 namespace fs = std::filesystem;
@@ -328,14 +329,7 @@ std::optional<FrameTruth> DatasetSource::truth() const {
   }
   if (!have_last_ || labels_.empty()) return std::nullopt;
   // Labels are matched by timestamp (1 ms: lists carry 6 decimals), else by frame index.
-  auto it = std::lower_bound(labels_.begin(), labels_.end(), last_t_,
-                             [](const FrameTruth& a, double t) { return a.timestamp < t; });
-  const FrameTruth* best = nullptr;
-  if (it != labels_.end()) best = &*it;
-  if (it != labels_.begin() &&
-      (!best || std::abs((it - 1)->timestamp - last_t_) < std::abs(best->timestamp - last_t_)))
-    best = &*(it - 1);
-  if (best && std::abs(best->timestamp - last_t_) <= 1e-3) return *best;
+  if (const FrameTruth* best = nearest_in_time(labels_, last_t_, 1e-3)) return *best;
   for (const auto& l : labels_)
     if (l.index == last_index_) return l;
   return std::nullopt;
@@ -343,14 +337,7 @@ std::optional<FrameTruth> DatasetSource::truth() const {
 
 std::optional<Pose> DatasetSource::pose() const {
   if (!have_last_ || groundtruth_.empty()) return std::nullopt;
-  auto it = std::lower_bound(groundtruth_.begin(), groundtruth_.end(), last_t_,
-                             [](const TimedPose& a, double t) { return a.timestamp < t; });
-  const TimedPose* best = nullptr;
-  if (it != groundtruth_.end()) best = &*it;
-  if (it != groundtruth_.begin() &&
-      (!best || std::abs((it - 1)->timestamp - last_t_) < std::abs(best->timestamp - last_t_)))
-    best = &*(it - 1);
-  if (best && std::abs(best->timestamp - last_t_) <= 5e-3) return best->T_world_camera;
+  if (const TimedPose* best = nearest_in_time(groundtruth_, last_t_, 5e-3)) return best->T_world_camera;
   return std::nullopt;
 }
 

@@ -112,10 +112,8 @@ bool read_folder_label_yaml(const std::string& path, FrameTruth& out) {
                    "unknown stair kind '" + kind + "' (ascending, descending, single_step, curb)");
     if (s.has("down")) {
       t.down = s.scalar<bool>("down");
-      if ((t.kind == StairKind::kAscending || t.kind == StairKind::kSingleStep) && t.down)
-        throw s.here(sn["down"], std::string("a ") + to_string(t.kind) + " cannot go down ('down: true')");
-      if (t.kind == StairKind::kDescending && !t.down)
-        throw s.here(sn["down"], "a descending staircase goes down ('down: false' given)");
+      if (const std::string why = down_contradiction(t.kind, t.down); !why.empty())
+        throw s.here(sn["down"], why);
     } else if (t.kind == StairKind::kCurb) {
       throw s.here(sn, "a curb needs 'down: true' (the ground drops) or 'down: false' (it rises)");
     } else {

@@ -245,10 +245,8 @@ std::vector<FrameTruth> read_labels_yaml(const std::string& path) {
       // does not, so a curb without it is refused rather than guessed.
       if (sn["down"]) {
         t.down = s.scalar<bool>("down");
-        if ((t.kind == StairKind::kAscending || t.kind == StairKind::kSingleStep) && t.down)
-          throw s.err(sn["down"], std::string("a ") + to_string(t.kind) + " cannot go down ('down: true')");
-        if (t.kind == StairKind::kDescending && !t.down)
-          throw s.err(sn["down"], "a descending staircase goes down ('down: false' given)");
+        if (const std::string why = down_contradiction(t.kind, t.down); !why.empty())
+          throw s.err(sn["down"], why);
       } else if (t.kind == StairKind::kCurb) {
         throw s.err(sn, "a curb needs 'down: true' (the ground drops) or 'down: false' (it rises)");
       } else {

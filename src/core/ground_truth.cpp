@@ -24,6 +24,14 @@ bool parse_stair_kind(const std::string& s, StairKind& out) {
   return false;
 }
 
+std::string down_contradiction(StairKind kind, bool down) {
+  if ((kind == StairKind::kAscending || kind == StairKind::kSingleStep) && down)
+    return std::string("a ") + to_string(kind) + " cannot go down ('down: true')";
+  if (kind == StairKind::kDescending && !down)
+    return "a descending staircase goes down ('down: false' given)";
+  return "";
+}
+
 bool FrameTruth::any_stair_visible() const {
   for (const auto& s : stairs)
     if (!s.visible_steps.empty() || s.first_edge_visible) return true;

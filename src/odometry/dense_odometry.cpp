@@ -254,26 +254,9 @@ OdometryResult DenseOdometry::Impl::track(const RgbdFrame& f) {
   res.photometric_rms = s.last.used > 0 ? static_cast<float>(std::sqrt(s.last.sum_rI2 / s.last.used)) : 0.f;
   res.inv_depth_rms = s.last.used > 0 ? static_cast<float>(std::sqrt(s.last.sum_rW2 / s.last.used)) : 0.f;
   res.converged = s.converged;
-  if (res.inlier_fraction < cfg.min_inlier_fraction) {
-    OdometryResult r = fail(OdometryStatus::kDiverged, true);
-    r.iterations = res.iterations;
-    r.pixels_used = res.pixels_used;
-    r.inlier_fraction = res.inlier_fraction;
-    r.residual = res.residual;
-    r.photometric_rms = res.photometric_rms;
-    r.inv_depth_rms = res.inv_depth_rms;
-    r.converged = res.converged;
-    return r;
-  }
-  if (trans > cfg.max_translation || rot > cfg.max_rotation) {
-    OdometryResult r = fail(OdometryStatus::kJump, true);
-    r.iterations = res.iterations;
-    r.pixels_used = res.pixels_used;
-    r.inlier_fraction = res.inlier_fraction;
-    r.residual = res.residual;
-    r.converged = res.converged;
-    return r;
-  }
+  // A failure keeps the figures of the solve just made (fail() changes only the outcome and the pose).
+  if (res.inlier_fraction < cfg.min_inlier_fraction) return fail(OdometryStatus::kDiverged, true);
+  if (trans > cfg.max_translation || rot > cfg.max_rotation) return fail(OdometryStatus::kJump, true);
 
   // Information of the perturbation: xi acts on the right of T_curr_ref, i.e. on the left of
   // T_ref_curr in the reference frame; with a skipped frame the reference frame is not the

@@ -24,6 +24,9 @@ enum class StairKind { kNone, kAscending, kDescending, kSingleStep, kCurb };
 const char* to_string(StairKind k);
 /// Parses the names above; returns false on an unknown name.
 bool parse_stair_kind(const std::string& s, StairKind& out);
+/// Why a label's `down` contradicts its kind (an ascending flight or a single step that goes down,
+/// a descending one that does not), or "" when they agree. A curb goes either way.
+std::string down_contradiction(StairKind kind, bool down);
 
 /// One staircase (or single step / curb) of a scene, as seen in one frame.
 struct StairTruth {

@@ -70,6 +70,22 @@ struct PerceptionOutput {
   double ms = 0.0;  ///< time spent in the stages
 };
 
+/// A made-up output of runtime frame `seq`: the user on an ascending flight, `climbed` steps up
+/// (the feedback stage driven without perception: `bench daemon`'s cue timing, the tests).
+inline PerceptionOutput climbing_output(std::uint64_t seq, int climbed) {
+  PerceptionOutput p;
+  p.seq = seq;
+  p.ran = true;
+  p.floor_found = true;
+  p.state = "ascending";
+  p.traversal.ran = true;
+  p.traversal.state = TraversalState::kOnStairs;
+  p.traversal.kind = StairKind::kAscending;
+  p.traversal.direction = 1;
+  p.traversal.steps_climbed = p.traversal.step_index = climbed;
+  return p;
+}
+
 /// What the odometry says of a frame's pose.
 enum class PoseAnswer {
   kReady,   ///< `link` holds its trusted pose

@@ -156,16 +156,8 @@ runtime::FeedbackStage::CueLatency cue_path(const PipelineConfig& config, int fr
     }
     std::this_thread::sleep_until(t0 + std::chrono::microseconds(33333) * i +
                                   std::chrono::seconds(i >= warmup ? 1 : 0));
-    runtime::PerceptionOutput p;
-    p.seq = static_cast<std::uint64_t>(i);
-    p.ran = true;
-    p.floor_found = true;
-    p.state = "ascending";
-    p.traversal.ran = true;
-    p.traversal.state = TraversalState::kOnStairs;
-    p.traversal.kind = StairKind::kAscending;
-    p.traversal.direction = 1;
-    p.traversal.steps_climbed = p.traversal.step_index = i < warmup ? 1 : 1 + (i - warmup) / 3;
+    const runtime::PerceptionOutput p =
+        runtime::climbing_output(static_cast<std::uint64_t>(i), i < warmup ? 1 : 1 + (i - warmup) / 3);
     stage.decide(p, nullptr, i / 30.0, std::chrono::steady_clock::now());
   }
   stage.drain(std::chrono::milliseconds(3000));

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "cli/write_image.hpp"
 #include "cli/open_input.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/perception/perception.hpp"
@@ -160,18 +161,7 @@ int analyze(Context& ctx) {
     const cv::Mat base = !frame.color.empty() ? frame.color : frame.gray;
     cv::Mat img = draw_classification(base, frame.depth, scene, perception.labels());
     draw_class_legend(img);
-    bool ok = false;
-    try {
-      ok = cv::imwrite(*png, img);
-    } catch (const cv::Exception& e) {
-      std::fprintf(stderr, "stairguide analyze: cannot write %s: %s\n", png->c_str(), e.what());
-      return 1;
-    }
-    if (!ok) {
-      std::fprintf(stderr, "stairguide analyze: cannot write %s (check the folder and the extension)\n",
-                   png->c_str());
-      return 1;
-    }
+    if (!write_image(*png, img, "stairguide analyze")) return 1;
   }
   return 0;
 }

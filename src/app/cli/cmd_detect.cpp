@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/command.hpp"
+#include "cli/write_image.hpp"
 #include "cli/open_input.hpp"
 #include "stairguide/core/json.hpp"
 #include "stairguide/capture/frame_source.hpp"
@@ -80,18 +81,7 @@ int detect(Context& ctx) {
     cv::Mat image = draw_classification(frame.color.empty() ? frame.gray : frame.color, frame.depth, scene,
                                         perception.labels(), 0.35f);
     draw_stair_model(image, frame.intrinsics, result);
-    bool ok = false;
-    try {
-      ok = cv::imwrite(*png, image);
-    } catch (const cv::Exception& e) {
-      std::fprintf(stderr, "stairguide detect: cannot write %s: %s\n", png->c_str(), e.what());
-      return 1;
-    }
-    if (!ok) {
-      std::fprintf(stderr, "stairguide detect: cannot write %s (unknown extension or unwritable folder)\n",
-                   png->c_str());
-      return 1;
-    }
+    if (!write_image(*png, image, "stairguide detect")) return 1;
   }
 
   if (json) {

@@ -24,6 +24,7 @@
 
 #include "cli/bench_util.hpp"
 #include "cli/command.hpp"
+#include "stairguide/core/nearest_in_time.hpp"
 #include "stairguide/capture/dataset.hpp"
 #include "stairguide/capture/frame_source.hpp"
 #include "stairguide/odometry/dense_odometry.hpp"
@@ -126,14 +127,7 @@ class TruthLookup {
       if (tr) return tr->T_world_camera;
       return std::nullopt;
     }
-    auto it = std::lower_bound(poses_.begin(), poses_.end(), t,
-                               [](const TimedPose& a, double v) { return a.timestamp < v; });
-    const TimedPose* best = nullptr;
-    if (it != poses_.end()) best = &*it;
-    if (it != poses_.begin() &&
-        (!best || std::fabs((it - 1)->timestamp - t) < std::fabs(best->timestamp - t)))
-      best = &*(it - 1);
-    if (best && std::fabs(best->timestamp - t) <= 0.02) return best->T_world_camera;
+    if (const TimedPose* best = nearest_in_time(poses_, t, 0.02)) return best->T_world_camera;
     return std::nullopt;
   }
 
