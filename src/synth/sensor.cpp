@@ -338,9 +338,10 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
   add_blurred(short_share, o.noise_short_px, 0x5eed0001ull);
   add_blurred(long_share, o.noise_long_px, 0x5eed0002ull);
   Stream rng(seed);
-  if (o.time_of_flight) {
-    // Time of flight (Kinect v2): noise in depth itself, rounded to the driver's millimetre.
-    const cv::Mat mp = o.multipath_m > 0.f ? multipath_bias(ideal, K, o) : cv::Mat();
+  // Every pixel draws one number (the stream stays aligned to pixels): its low bits drop it, its
+  // high bits pick its white noise, mixed with the correlated field; `measure(zp, n, v, u)` turns
+  // the true depth and that noise into the depth the sensor reports (0: none).
+  auto each_pixel = [&](auto measure) {
     for (int v = 0; v < H; ++v) {
       const float* z = ideal.depth.ptr<float>(v);
       float* out = depth_out.ptr<float>(v);
@@ -355,37 +356,26 @@ void apply_depth_sensor(const RenderBuffers& ideal, const CameraIntrinsics& K, c
         }
         float n = g[(r >> 48) & detail::kGaussianMask];
         if (cr) n = white_weight * n + cr[u];
-        const float zm = mp.empty() ? zp : zp + mp.ptr<float>(v)[u];
-        const float zn = round_pos((zm + (o.tof_sigma_m + o.tof_sigma_per_m2 * zp * zp) * n) * inv_ds) * ds;
+        const float zn = measure(zp, n, v, u);
         out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
       }
     }
-    apply_real_artefacts(ideal, o, seed, depth_out);
-    return;
-  }
-  for (int v = 0; v < H; ++v) {
-    const float* z = ideal.depth.ptr<float>(v);
-    float* out = depth_out.ptr<float>(v);
-    const unsigned char* hr = &hole[static_cast<std::size_t>(v * W)];
-    const float* cr = correlated.empty() ? nullptr : correlated.ptr<float>(v);
-    for (int u = 0; u < W; ++u) {
-      const std::uint64_t r = rng.next();  // one draw per pixel keeps the stream aligned to pixels
-      const float zp = z[u];
-      if (zp < zmin || zp > zmax || hr[u] || ((r >> 16) & 0xFFFF) < drop_threshold) {
-        out[u] = 0.f;
-        continue;
-      }
-      float n = g[(r >> 48) & detail::kGaussianMask];
-      if (cr) n = white_weight * n + cr[u];
+  };
+  if (o.time_of_flight) {
+    // Time of flight (Kinect v2): noise in depth itself, rounded to the driver's millimetre.
+    const cv::Mat mp = o.multipath_m > 0.f ? multipath_bias(ideal, K, o) : cv::Mat();
+    each_pixel([&](float zp, float n, int v, int u) {
+      const float zm = mp.empty() ? zp : zp + mp.ptr<float>(v)[u];
+      return round_pos((zm + (o.tof_sigma_m + o.tof_sigma_per_m2 * zp * zp) * n) * inv_ds) * ds;
+    });
+  } else {
+    // Structured light (Kinect v1): noise in disparity, quantised to the sensor's sub-pixel step.
+    each_pixel([&](float zp, float n, int, int) {
       float d = F / zp + sigma[static_cast<std::size_t>(zp * 100.f + 0.5f)] * n;
-      if (d <= 0.5f * q) {
-        out[u] = 0.f;
-        continue;
-      }
+      if (d <= 0.5f * q) return 0.f;
       d = round_pos(d * inv_q) * q;
-      const float zn = round_pos((F / d) * inv_ds) * ds;
-      out[u] = (zn >= zmin && zn <= zmax) ? zn : 0.f;
-    }
+      return round_pos((F / d) * inv_ds) * ds;
+    });
   }
   apply_real_artefacts(ideal, o, seed, depth_out);
 }
