@@ -27,6 +27,17 @@ namespace sgtest {
 
 namespace fs = std::filesystem;
 
+/// Adds the real 7-Scenes kitchen (no stairs, no drop) to `runs` as {name, its folder} when the
+/// shared data has it; says so on stderr when it does not.
+inline void add_real_kitchen(std::vector<std::pair<std::string, std::string>>& runs,
+                             const std::string& name) {
+  const fs::path kitchen = fs::path(STAIRGUIDE_SHARED_DATA) / "7scenes-redkitchen-0000-0299";
+  if (fs::exists(kitchen))
+    runs.push_back({name, kitchen.string()});
+  else
+    std::fprintf(stderr, "note: %s absent, the %s run is skipped\n", kitchen.c_str(), name.c_str());
+}
+
 inline std::string sounds_dir() { return std::string(STAIRGUIDE_SOURCE_DIR) + "/sounds"; }
 
 /// A folder of this test process's own, `NAME.PID` in the build tree (ctest runs each case in a

@@ -98,13 +98,9 @@ TEST(E2eFeedback, DescentWarns) {
 }
 
 TEST(E2eFeedback, StairFreeSequencesSayNothingAboutStairs) {
-  const fs::path kitchen = fs::path(STAIRGUIDE_SHARED_DATA) / "7scenes-redkitchen-0000-0299";
   std::vector<std::pair<std::string, std::string>> runs = {{"e2e_corridor", "synth:corridor_static:60"},
                                                            {"e2e_table", "synth:table_static:60"}};
-  if (fs::exists(kitchen))
-    runs.push_back({"e2e_kitchen", kitchen.string()});
-  else
-    std::fprintf(stderr, "note: %s absent, the kitchen case is skipped\n", kitchen.c_str());
+  sgtest::add_real_kitchen(runs, "e2e_kitchen");
   for (const auto& [name, replay] : runs) {
     const Result r = run_daemon(name, replay, "--fast --sync");
     ASSERT_EQ(r.code, 0) << name << r.log;

@@ -81,14 +81,10 @@ TEST(E2eFeedbackDrops, WalkTowardsAPlatformEdgeSaysDropAheadBeforeTheEdge) {
 }
 
 TEST(E2eFeedbackDrops, StairFreeWalksSayNoDrop) {
-  const fs::path kitchen = fs::path(STAIRGUIDE_SHARED_DATA) / "7scenes-redkitchen-0000-0299";
   std::vector<std::pair<std::string, std::string>> runs = {
       {"e2e_drop_room", "synth:room_clutter_static:60:5:real-v1"},
       {"e2e_drop_corridor", "synth:corridor_static:60:5:real-v2"}};
-  if (fs::exists(kitchen))
-    runs.push_back({"e2e_drop_kitchen", kitchen.string()});
-  else
-    std::fprintf(stderr, "note: %s absent, the kitchen walk is skipped\n", kitchen.c_str());
+  sgtest::add_real_kitchen(runs, "e2e_drop_kitchen");
   for (const auto& [name, replay] : runs) {
     const sgtest::DaemonRun r = run_daemon(name, replay);
     ASSERT_EQ(r.code, 0) << name << r.log;

@@ -70,13 +70,16 @@ std::vector<std::string> toks(const std::vector<Said>& s) {
   return t;
 }
 
-/// The times of the approach beeps.
-std::vector<double> beeps(const std::vector<Said>& s) {
+/// The times `cue` was said.
+std::vector<double> times_of(const std::vector<Said>& s, Cue cue) {
   std::vector<double> t;
   for (const auto& x : s)
-    if (x.e.cue == Cue::kApproach) t.push_back(x.t);
+    if (x.e.cue == cue) t.push_back(x.t);
   return t;
 }
+
+/// The times of the approach beeps.
+std::vector<double> beeps(const std::vector<Said>& s) { return times_of(s, Cue::kApproach); }
 
 bool about_stairs(const CueEvent& e) {
   return e.cue == Cue::kStairsAhead || e.cue == Cue::kDropWarning || e.cue == Cue::kStepAhead ||
@@ -261,9 +264,7 @@ TEST(FeedbackPolicy, RateLimitBetweenTwoAnnouncements) {
   for (double t = 0.5; t < 3.0; t += kDt) f.push_back(stair_frame(t, StairKind::kDescending, 3.5f));
   const auto s = feed(p, f);
   ASSERT_EQ(count_of(s, Cue::kStairsAhead), 2) << ::testing::PrintToString(toks(s));
-  std::vector<double> ts;
-  for (const auto& x : s)
-    if (x.e.cue == Cue::kStairsAhead) ts.push_back(x.t);
+  const std::vector<double> ts = times_of(s, Cue::kStairsAhead);
   EXPECT_GE(ts[1] - ts[0], 1.5 - 1e-9);
   EXPECT_LT(ts[1] - ts[0], 1.5 + kDt + 1e-9);
 }
@@ -279,9 +280,7 @@ TEST(FeedbackPolicy, BlindToldOnceThenAtTheSlowInterval) {
     f.push_back(in);
   }
   const auto s = feed(p, f);
-  std::vector<double> ts;
-  for (const auto& x : s)
-    if (x.e.cue == Cue::kBlind) ts.push_back(x.t);
+  const std::vector<double> ts = times_of(s, Cue::kBlind);
   ASSERT_EQ(ts.size(), 3u) << ::testing::PrintToString(toks(s));
   EXPECT_NEAR(ts[0], 3.0, kDt + 1e-6);
   EXPECT_NEAR(ts[1] - ts[0], 30.0, kDt + 1e-6);
@@ -430,9 +429,7 @@ TEST(FeedbackPolicy, TicksRateLimitedOnAFlickeringCount) {
     f.push_back(in);
   }
   const auto s = feed(p, f);
-  std::vector<double> ts;
-  for (const auto& x : s)
-    if (x.e.cue == Cue::kTick) ts.push_back(x.t);
+  const std::vector<double> ts = times_of(s, Cue::kTick);
   ASSERT_GE(ts.size(), 2u);
   EXPECT_LE(ts.size(), 3u);  // 20 frames = 0.67 s
   for (std::size_t i = 1; i < ts.size(); ++i) EXPECT_GE(ts[i] - ts[i - 1], 0.25 - 1e-9);
@@ -700,9 +697,7 @@ TEST(FeedbackPolicy, SlowWhenPerceptionIsBehindLongEnough) {
     f.push_back(in);
   }
   const auto s = feed(p, f);
-  std::vector<double> slow;
-  for (const auto& x : s)
-    if (x.e.cue == Cue::kSlow) slow.push_back(x.t);
+  const std::vector<double> slow = times_of(s, Cue::kSlow);
   ASSERT_EQ(slow.size(), 1u) << ::testing::PrintToString(toks(s));
   EXPECT_NEAR(slow[0], 3.3 + c.slow_after, 2 * kDt + 1e-9);  // 3 s into the long spell, not the short one
   // Quiet verbosity too; back on time and behind again: told again at once after slow_after.

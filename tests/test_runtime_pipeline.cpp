@@ -396,6 +396,19 @@ TEST(Runtime, WatchdogIsPingedFromThePerceptionLoop) {
   EXPECT_GE(n.count("STATUS="), 1);
 }
 
+namespace {
+
+/// Starts `rt` and runs it to the end of its input: on this thread (`sync`), or waiting up to
+/// `bound` for its threads to finish and join. Returns its exit code (-1: did not finish in time).
+int run_to_the_end(Runtime& rt, bool sync, std::chrono::seconds bound) {
+  rt.start();
+  if (sync) return rt.run();
+  if (!rt.wait_finished(bound) || !rt.join(std::chrono::seconds(2))) return -1;
+  return rt.exit_code();
+}
+
+}  // namespace
+
 // The daemon hands perception the odometry's pose of the very frame it works on, and perception
 // carries the Manhattan frame seen earlier to the views of a fast turn whose own wall is a strip
 // too narrow to make one (test_walk_manhattan checks those frames' yaw against the truth).
@@ -416,16 +429,9 @@ TEST(Runtime, ManhattanFrameIsCarriedByTheOdometryThroughAFastTurn) {
     o.frame_lines = true;
     o.frame_out = lines.f;
     Runtime rt(quiet_config(), o, nullptr);
-    rt.start();
-    if (sync) {
-      EXPECT_EQ(rt.run(), 0);
-    } else {
-      // 110 frames of the full pipeline took past 120 s under ThreadSanitizer with parallel
-      // builds loading the 2 cores: the bound says "finishes", not how fast.
-      ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(400)));
-      ASSERT_TRUE(rt.join(std::chrono::seconds(1)));
-      EXPECT_EQ(rt.exit_code(), 0);
-    }
+    // 110 frames of the full pipeline took past 120 s under ThreadSanitizer with parallel builds
+    // loading the 2 cores: the bound says "finishes", not how fast.
+    ASSERT_EQ(run_to_the_end(rt, sync, std::chrono::seconds(400)), 0);
     int seen = 0, carried = 0;
     for (const auto& kv : lines.parse()) {
       seen += kv.at("manhattan") == "seen";
@@ -680,14 +686,7 @@ TEST(Runtime, OutOfMemoryInAThreadIsLoggedAndFailsTheRun) {
     b.frames = 100;
     b.bad_alloc_at = 10;
     Runtime rt(quiet_config(), replay_options(b, false, sync, nullptr), nullptr);
-    rt.start();
-    if (sync) {
-      EXPECT_EQ(rt.run(), 1);
-    } else {
-      ASSERT_TRUE(rt.wait_finished(std::chrono::seconds(30)));
-      ASSERT_TRUE(rt.join(std::chrono::seconds(2)));
-    }
-    EXPECT_EQ(rt.exit_code(), 1);
+    EXPECT_EQ(run_to_the_end(rt, sync, std::chrono::seconds(30)), 1);
     EXPECT_EQ(rt.stats().state, "failed");
     const std::string text = log.text();
     EXPECT_NE(text.find(std::string(sync ? "pipeline (one thread)" : "capture") +
