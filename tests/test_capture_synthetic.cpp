@@ -47,12 +47,7 @@ struct TestWorld {
   TestWorld() {
     scene.add_box_world({-5.f, -5.f, -0.2f}, {10.f, 5.f, 0.f}, plain(), "floor");
     scene.add_box_world({6.f, -5.f, 0.f}, {6.2f, 5.f, 3.f}, plain(), "wall");
-    StairParams p;
-    p.kind = StairKind::kAscending;
-    p.steps = steps;
-    p.riser_m = riser;
-    p.tread_m = tread;
-    p.width_m = width;
+    StairParams p = flight_params(StairKind::kAscending, steps, riser, tread, width);
     p.side_walls = false;
     p.T_world_stair = stair_pose(2.0f, 0.1f, 0.f, riser);
     Rng rng(3);

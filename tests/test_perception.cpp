@@ -288,6 +288,16 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+void print_figures(const char* name, const Figures& f, bool with_yaw) {
+  std::printf(
+      "%s: frames %d floor ok %d treads %d/%d mixed %d worst h %.3f tilt %.2f roll %.2f tread n %.2f "
+      "tread H %.3f",
+      name, f.frames, f.floor_ok, f.treads_found, f.treads, f.mixed, f.worst_h, f.worst_tilt, f.worst_roll,
+      f.worst_tread_n, f.worst_tread_h);
+  if (with_yaw) std::printf(" yaw %.2f", f.worst_yaw);
+  std::printf(" median %.2f ms (cpu %.2f)\n", median(f.ms), median(f.cpu_ms));
+}
+
 void run_rendered(bool ascending, std::uint32_t seed0, int frames, Figures& f) {
   std::mt19937 rng(seed0);
   std::uniform_real_distribution<float> U(0.f, 1.f);
@@ -318,11 +328,7 @@ void run_rendered(bool ascending, std::uint32_t seed0, int frames, Figures& f) {
 TEST(PerceptionRendered, AscendingStairs) {
   Figures f;
   run_rendered(true, 11, 12, f);
-  std::printf(
-      "ascending: frames %d floor ok %d treads %d/%d mixed %d worst h %.3f tilt %.2f roll %.2f tread n %.2f "
-      "tread H %.3f yaw %.2f median %.2f ms (cpu %.2f)\n",
-      f.frames, f.floor_ok, f.treads_found, f.treads, f.mixed, f.worst_h, f.worst_tilt, f.worst_roll,
-      f.worst_tread_n, f.worst_tread_h, f.worst_yaw, median(f.ms), median(f.cpu_ms));
+  print_figures("ascending", f, true);
   // One frame has a floor strip no wider than the staircase right ahead: reported as no floor.
   EXPECT_GE(f.floor_ok, f.frames - 1);
   EXPECT_EQ(f.treads_found, f.treads);
@@ -333,11 +339,7 @@ TEST(PerceptionRendered, AscendingStairs) {
 TEST(PerceptionRendered, DescendingStairs) {
   Figures f;
   run_rendered(false, 23, 12, f);
-  std::printf(
-      "descending: frames %d floor ok %d treads %d/%d mixed %d worst h %.3f tilt %.2f roll %.2f tread n %.2f "
-      "tread H %.3f median %.2f ms (cpu %.2f)\n",
-      f.frames, f.floor_ok, f.treads_found, f.treads, f.mixed, f.worst_h, f.worst_tilt, f.worst_roll,
-      f.worst_tread_n, f.worst_tread_h, median(f.ms), median(f.cpu_ms));
+  print_figures("descending", f, false);
   EXPECT_EQ(f.floor_ok, f.frames);
   EXPECT_GE(f.treads_found, 0.7 * f.treads);  // far descending treads: a known gap (see report)
   EXPECT_LE(f.mixed, 5);

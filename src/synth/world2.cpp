@@ -161,12 +161,7 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   const Material wall_m = wall_material(rng);
 
   // The lower flight, going down from the landing's edge at x = 0 towards -x.
-  StairParams lo;
-  lo.kind = StairKind::kDescending;
-  lo.steps = n_lo;
-  lo.riser_m = R;
-  lo.tread_m = T;
-  lo.width_m = W;
+  StairParams lo = flight_params(StairKind::kDescending, n_lo, R, T, W);
   lo.nosing_m = nosing;
   lo.build_floor = false;
   lo.side_walls = false;
@@ -187,12 +182,7 @@ void turn_static(Rng& rng, const SynthOptions& o, PresetBuild& b) {
   }
 
   // The upper flight, rising from the landing.
-  StairParams up;
-  up.kind = StairKind::kAscending;
-  up.steps = n_up;
-  up.riser_m = R;
-  up.tread_m = T;
-  up.width_m = W;
+  StairParams up = flight_params(StairKind::kAscending, n_up, R, T, W);
   up.nosing_m = nosing;
   up.top_depth_m = rng.uniform(1.2f, 2.5f);
   up.handrails = lo.handrails;

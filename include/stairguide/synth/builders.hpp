@@ -68,6 +68,19 @@ struct StairParams {
   bool build_floor = true;  ///< also build the floor before the edge (and the lower floor for descending)
 };
 
+/// A flight's parameters with its dimensions given (everything else as StairParams has it). Pass
+/// values, not random draws: the order in which arguments are evaluated is not fixed, and a preset's
+/// draws must come in one order to make the same scene on every compiler.
+inline StairParams flight_params(StairKind kind, int steps, float riser_m, float tread_m, float width_m) {
+  StairParams p;
+  p.kind = kind;
+  p.steps = steps;
+  p.riser_m = riser_m;
+  p.tread_m = tread_m;
+  p.width_m = width_m;
+  return p;
+}
+
 /// T_world_stair for a staircase whose first edge centre is at ground point (x, y) with
 /// direction of travel `yaw` (rad from world +x), at world height `edge_z`.
 Pose stair_pose(float x, float y, float yaw, float edge_z);
