@@ -626,10 +626,12 @@ TEST(ManhattanFrame, RiserCornerAtTheImageEdgeGivesTheFrame) {
 // user) is still level: the walls and risers are upright about its normal, and the frame is
 // measured about it (before, "no floor" meant no frame: these views and 23 more on the held-out
 // seeds, all now within 0.61 deg). ascending_short #13 looks up a stairwell; nosing_landing #0
-// seed 10 at a flight's foot; people #15 seed 1 past people at the foot of one.
+// seed 10 at a flight's foot; people #13 seed 6 past people at the foot of one (people #15 seed 1,
+// here before, has its floor now, by the floor detector's rule for a strip of floor at the view's bottom
+// edge).
 TEST(ManhattanFrame, FloorRefusedStillGivesTheVertical) {
   const Case views[] = {
-      {"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 15, 1}};
+      {"ascending_short_static", 13, kSuiteSeed}, {"nosing_landing_static", 0, 10}, {"people_static", 13, 6}};
   ManhattanConfig off;
   off.without_floor = false;
   for (const auto& c : views) {

@@ -112,37 +112,62 @@ bool FloorDetector::drop_under_edge(const PlaneRegion& r, const RgbdFrame& frame
   // stands on has nothing lower just under it (it reaches the view's border, or continues, or
   // things stand on it). Walking the depth image column by column costs a few hundred pixels per
   // column where the edge is in view, far less than the region's pixel list.
+  //
+  // Where the plane itself reaches the view's bottom edge in some columns, the user's level runs
+  // on there under the user's side, and what drops under its edge in the other columns, deeper
+  // than any riser (ambiguous_rise_max), is ahead of the user: a hole, a sunken floor or a
+  // platform's edge seen across (its far wall under the floor beyond it). Those columns then count
+  // as columns with no riser, unless a lower level that could be the user's floor (at the rig's
+  // height; the usual chest rig's while none is learned) is what the view's bottom edge sees beside
+  // it: then the plane may be a low table or a seat standing on that floor, and only the columns
+  // where its near edge is in view tell. A drop of a few cm is no hole (two fits of one real floor
+  // a few degrees apart), and tells as before.
   constexpr float kDrop = 0.025f;  // m, below the candidate by more than its noise
   constexpr int kRows = 16;        // px under the edge where a drop counts
   constexpr int kColStep = 4;      // px between the columns looked at
+  constexpr int kMinColumns = 8;   // columns of a riser (or of a floor beside) before it counts
   const cv::Mat& D = frame.depth;
   if (D.empty() || D.type() != CV_32FC1) return false;
   const int W = D.cols, H = D.rows;
   const CameraIntrinsics& K = frame.intrinsics;
-  int columns = 0, dropped = 0;
+  int columns = 0, dropped = 0, deep = 0, underfoot = 0, floor_beside = 0;
   for (int u = 0; u < W; u += kColStep) {
     const float un = (static_cast<float>(u) - K.cx) / K.fx;
-    int drop_row = -1;  // the highest row seen so far with a point clearly below the plane
+    int drop_row = -1;   // the highest row seen so far with a point clearly below the plane
+    float lowest = 0.f;  // m, the lowest point seen below the plane in this column (negative)
+    bool first = true;   // the column's lowest reading in view
     for (int v = H - 1; v >= 0; --v) {
       const float z = D.at<float>(v, u);
       if (!(z > 0.f) || !std::isfinite(z)) continue;
       const Eigen::Vector3f q(un * z, (static_cast<float>(v) - K.cy) / K.fy * z, z);
       const float h = r.normal.dot(q) + r.offset;
       if (h < -kDrop) {
+        if (first && v >= H - 3 && could_be_floor(-r.normal.dot(q))) ++floor_beside;
+        first = false;
+        lowest = std::min(lowest, h);
         if (!below_any_floor(r.normal, q)) drop_row = v;
         continue;
       }
+      first = false;
       if (h > cfg_.inlier_distance) continue;
       // On the plane: its nearest row in this column.
-      if (v < H - 3) {
+      if (v >= H - 3) {
+        ++underfoot;
+      } else {
         ++columns;
-        if (drop_row >= 0 && drop_row - v <= kRows + 2) ++dropped;
+        if (drop_row >= 0 && drop_row - v <= kRows + 2) {
+          ++dropped;
+          deep += lowest < -cfg_.ambiguous_rise_max;
+        }
       }
       break;
     }
   }
-  // A riser runs along the tread's whole edge; a stray hole or a cable does not.
-  return columns >= 8 && dropped * 2 >= columns;
+  // A riser runs along the tread's whole edge; a stray hole or a cable does not. The columns where
+  // the plane runs on under the user only weigh against the drop, never make one count.
+  const bool hole = deep * 2 > dropped && floor_beside < kMinColumns;
+  const int weighed = columns + (hole ? underfoot : 0);
+  return columns >= kMinColumns && dropped * 2 >= weighed;
 }
 
 FloorEstimate FloorDetector::select(const std::vector<PlaneRegion>& regions, const RgbdFrame& frame,
@@ -546,7 +571,12 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
         chosen = i;
       }
     }
-    if (chosen >= 0 && regions[chosen].area < 0.25f * cfg_.min_area) chosen = -1;
+    // A piece smaller than that is a sliver, unless the rig is learned and the piece lies at its
+    // height and tilt: then the floor tracked frame after frame is what is left in view of it (a
+    // standing wearer whose flight fills the view but for a strip of floor before it).
+    if (chosen >= 0 && regions[chosen].area < 0.25f * cfg_.min_area &&
+        !(rig_height_ && agrees_with_rig(regions[chosen]) && level_confirmed(regions, chosen)))
+      chosen = -1;
     if (chosen >= 0) {
       tracked = true;
       return chosen;
@@ -594,6 +624,7 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
       }
     }
   }
+  if (chosen < 0) chosen = strip_at_feet(regions, cand);
   if (chosen >= 0) {
     // The user stands on the floor: of two parallel candidates a riser or more apart, the floor
     // is the lower one when it reaches as near the user's feet in the view (a seat, a first step
@@ -617,6 +648,58 @@ int FloorDetector::choose(const std::vector<PlaneRegion>& regions, const std::ve
     }
   }
   return chosen;
+}
+
+bool FloorDetector::level_confirmed(const std::vector<PlaneRegion>& regions, int c) const {
+  // A strip a few cm deep fixes its normal poorly (a 4 cm sliver of floor under a first riser fitted
+  // 5 deg off, 7 cm off in height); a level of min_area or more in view fixes "up" well. The strip's
+  // normal must agree with such a level's, within what a well-fixed plane of a few hundred pixels
+  // per cm of depth gives.
+  constexpr float kAgreement = 0.035f;  // rad (2 deg)
+  const float cos_agree = std::cos(kAgreement);
+  for (std::size_t j = 0; j < regions.size(); ++j)
+    if (static_cast<int>(j) != c && regions[j].area >= cfg_.min_area &&
+        regions[j].normal.dot(regions[c].normal) >= cos_agree)
+      return true;
+  return false;
+}
+
+bool FloorDetector::could_be_floor(float below) const {
+  if (rig_height_) return std::fabs(below - *rig_height_) <= cfg_.rig_height_tolerance;
+  // Not yet learned: the usual chest rig is the prior.
+  return below >= cfg_.usual_height_min && below <= cfg_.usual_height_max;
+}
+
+bool FloorDetector::agrees_with_rig(const PlaneRegion& r) const {
+  float tilt, roll;
+  tilt_roll_from_up(r.normal, tilt, roll);
+  if (std::fabs(roll) > cfg_.roll_max || !could_be_floor(r.offset)) return false;
+  if (rig_tilt_) return std::fabs(tilt - *rig_tilt_) <= cfg_.rig_tilt_tolerance;
+  return tilt >= cfg_.usual_tilt_min && tilt <= cfg_.usual_tilt_max;
+}
+
+int FloorDetector::strip_at_feet(const std::vector<PlaneRegion>& regions,
+                                 const std::vector<int>& cand) const {
+  // Standing 0.5-0.7 m from an edge (a platform, a dock, a hole) or at the foot of a flight that
+  // fills the view, the floor in view is a strip along the view's bottom edge, smaller than
+  // min_area in every window. Its area says little; where it lies says much: the level the view's
+  // bottom edge sees (the border nearest the user's feet), at the height and tilt of the rig
+  // (learned, or the usual chest rig while not yet learned). Such a strip is offered as the floor
+  // when no bigger one is; every check of a floor (nothing lower nearer the feet, no tread, no level
+  // underfoot above it) then applies as to any other candidate.
+  const int W = K_.width, H = K_.height;
+  if (W <= 0 || H <= 0) return -1;
+  const int edge_row = H - 1 - std::max(2, H / 60);  // rows this low are the view's bottom edge
+  int best = -1;
+  for (int i : cand) {
+    const PlaneRegion& r = regions[i];
+    if (r.pixels.empty() || !agrees_with_rig(r) || !level_confirmed(regions, i)) continue;
+    int lowest_row = 0;
+    for (int p : r.pixels) lowest_row = std::max(lowest_row, p / W);
+    if (lowest_row < edge_row) continue;  // its near edge is seen: not what the user stands on
+    if (best < 0 || r.area > regions[best].area) best = i;
+  }
+  return best;
 }
 
 }  // namespace stairguide

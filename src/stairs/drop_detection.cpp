@@ -106,7 +106,11 @@ bool judge_beyond(const std::vector<Sample>& col, std::size_t last, const DropCo
     }
   }
   resume = i;
-  if (n < kMinBeyond || floor >= 2) return false;
+  // The floor resuming within the look-ahead is a gap in the readings, unless surfaces deeper than
+  // a step were seen in the gap: then it is a hole narrower than the look-ahead (its bottom or
+  // its far wall seen below the floor between its edges), a drop all the same.
+  const bool resumed = floor >= 2;
+  if (n < kMinBeyond) return false;
   int deep = 0, other = 0, classified = 0, first_levels = 0;
   std::vector<float> depths;
   for (std::size_t k = 0; k < beyond.size(); ++k) {
@@ -134,7 +138,7 @@ bool judge_beyond(const std::vector<Sample>& col, std::size_t last, const DropCo
     return true;
   }
   // No reading beyond the edge where the floor would have been read: consistent with a drop.
-  if (deep + other <= 1 && unseen == 0 && missing >= 2) {
+  if (!resumed && deep + other <= 1 && unseen == 0 && missing >= 2) {
     out.edge = true;
     return true;
   }

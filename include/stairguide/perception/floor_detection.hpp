@@ -39,6 +39,11 @@
 /// user's nadir on its side is not taken either: the user may stand on that level.
 /// Of parallel candidates, a lower one reaching as near the user's feet (angle from the nadir)
 /// wins over a higher one (a seat or a platform beside the floor).
+/// A strip smaller than min_area in every window (0.5-0.7 m from a platform's edge, a hole, or a
+/// flight filling the view) is offered as the floor when no bigger plane is, if it is cut by the
+/// view's bottom edge at the rig's height and tilt (learned, or the usual chest rig's while none
+/// is) with its normal within 2 deg of a bigger level's in view; every check above then applies to
+/// it as to any candidate. Once the rig is learned, such a piece of the tracked floor is tracked.
 
 #include <optional>
 #include <string>
@@ -125,6 +130,18 @@ class FloorDetector {
  private:
   int choose(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand, float area_k,
              bool& tracked);
+  // Cold or not, a candidate smaller than min_area in every window cut by the view's bottom edge at
+  // the rig's height and tilt (the usual chest rig while none is learned): the strip of floor at the
+  // user's feet before an edge or a flight filling the view; -1 when none.
+  int strip_at_feet(const std::vector<PlaneRegion>& regions, const std::vector<int>& cand) const;
+  // Candidate c's normal agrees closely with that of a level of min_area or more in view (a small
+  // strip's own normal is poorly fixed; a big level's says where "up" is).
+  bool level_confirmed(const std::vector<PlaneRegion>& regions, int c) const;
+  // The plane's height and tilt are those of the rig (learned; while not, the usual chest rig).
+  bool agrees_with_rig(const PlaneRegion& r) const;
+  // A level `below` m under the camera could be what the user stands on (the rig's height, learned
+  // or the usual chest rig's).
+  bool could_be_floor(float below) const;
   struct Reach {
     float distance = 1e9f;  // m from the camera's foot to the plane's near edge
     float angle = 1.6f;     // rad from the nadir to the plane's near edge
