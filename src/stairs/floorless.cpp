@@ -35,6 +35,43 @@ void copy_region(const PlaneRegion& src, PlaneRegion& dst) {
   dst.hull_extent = src.hull_extent;
 }
 
+// m, slack on a foot's depth (WalkableLimits::tread_min) for a level's mean depth (its area over
+// its length: hull areas of noisy points).
+constexpr float kFootSlack = 0.02f;
+// A region reaches the bottom of the view when its lowest row (as y/z) is within this of the
+// lowest any region reaches (about 10 px at a 525 px focal length).
+constexpr float kViewBottomSlack = 0.02f;
+
+// Going up with the tread unknown (fewer than two step edges seen), a level below the top one,
+// seen whole (not cut by the bottom of the view), whose mean depth (area over its length) is less
+// than a foot's: nothing stands on it. A bed frame's rim 3-5 cm wide round the mattress was the
+// first "step" of a two-level flight (world2_bed seed 1003 #8: rim pieces 3.6 and 1.3 cm deep on
+// average, perception's floor doubted, the remembered camera height placing the flight).
+bool level_too_shallow(const SceneResult& scene, int dir, int n, const StairResult& out) {
+  if (dir <= 0 || n < 2 || static_cast<int>(out.level_data.size()) != n + 1) return false;
+  auto lowest_row = [](const PlaneRegion& r) {
+    float low = -std::numeric_limits<float>::max();
+    for (const Eigen::Vector3f& p : r.points)
+      if (p.z() > 0.05f) low = std::max(low, p.y() / p.z());
+    return low;
+  };
+  float bottom = -std::numeric_limits<float>::max();
+  for (const PlaneRegion& r : scene.regions) bottom = std::max(bottom, lowest_row(r));
+  for (int k = 1; k < n; ++k) {
+    float area = 0.f, length = 0.f;
+    bool cut = false;
+    for (int i : out.level_data[static_cast<std::size_t>(k)].regions) {
+      if (i < 0 || i >= static_cast<int>(scene.regions.size())) return false;
+      const PlaneRegion& r = scene.regions[static_cast<std::size_t>(i)];
+      area += r.area;
+      length = std::max(length, r.rect_length_major);
+      cut = cut || lowest_row(r) >= bottom - kViewBottomSlack;
+    }
+    if (!cut && length > 0.f && area / length < WalkableLimits{}.tread_min - kFootSlack) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 FloorlessStairs::FloorlessStairs(const ClassificationConfig& classification,
@@ -256,6 +293,8 @@ void FloorlessStairs::refine_edges(const SceneResult& scene, const CameraIntrins
   dims.width_complete = out.width_complete;
   dims.range = out.T_camera_stair.translation().norm();
   out.verdict = check_walkable(dims, mod_.dimension_tolerance, mod_.tread_tolerance_per_m2);
+  if (out.verdict == StairVerdict::kDetected && !dims.tread_known && level_too_shallow(scene, dir, n, out))
+    out.verdict = StairVerdict::kTreadTooShort;
   out.code_notes = describe_against_code(dims, true, mod_);
   out.detected = out.verdict == StairVerdict::kDetected;
 }

@@ -102,6 +102,16 @@ class StairDetection {
   bool build_stack(StairHypothesis& hyp);
   /// Lowest image row (as y/z) that any region of the scene reaches: the bottom of the view.
   float view_bottom(const SceneResult& scene) const;
+  /// Ascending: a solid upright face stands between level k-1 and level k of `hyp` (its riser):
+  /// facing the user, from the lower level up to the upper one's near edge, level k behind it,
+  /// across most of level k's width. What a shelf board or a seat over open space lacks.
+  bool riser_seen(const StairHypothesis& hyp, int k);
+  /// A region of level k of `hyp` reaches the bottom of the view (its depth there is cut).
+  bool reaches_view_bottom(const StairHypothesis& hyp, int k);
+  /// How far level k-1 of `hyp` (0: the floor) reaches before level k starts, horizontally (m).
+  float going(const StairHypothesis& hyp, int k);
+  /// The sampled points of level k of `hyp` (0: the floor) into `pts`.
+  void level_points(const StairHypothesis& hyp, int k, std::vector<Eigen::Vector3f>& pts) const;
 
   ClassificationConfig cls_;
   StairDetectionConfig cfg_;
@@ -115,10 +125,12 @@ class StairDetection {
   std::vector<LevelSeed> saved_levels_;
   std::vector<char> saved_assigned_, left_out_;
   std::vector<float> dist_;
+  std::vector<Eigen::Vector3f> upper_, lower_;  ///< scratch for riser_seen: the two levels' points
   int used_ = 0;
   bool floor_tracked_ = false;
   bool hidden_sweep_ = false;  ///< build_hidden's sweep: the first level's index is provisional
   Eigen::Vector3f up_ = -Eigen::Vector3f::UnitY();  ///< floor's up, camera frame
+  float up_offset_ = 0.f;                           ///< height above the floor = up_ . p + up_offset_
   float view_bottom_ = 0.f;                         ///< of the current scene, see view_bottom()
   const SceneResult* scene_ = nullptr;              ///< the scene being run (only during run())
 };
